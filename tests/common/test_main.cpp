@@ -1,0 +1,29 @@
+// GoogleTest main for every bfemp test: brings up MPI, Kokkos and Tpetra once.
+#include <gtest/gtest.h>
+#include <mpi.h>
+
+#include <Kokkos_Core.hpp>
+#include <Tpetra_Core.hpp>
+
+int main(int argc, char** argv) {
+  int provided = 0;
+  MPI_Init_thread(&argc, &argv, MPI_THREAD_FUNNELED, &provided);
+  ::testing::InitGoogleTest(&argc, argv);
+  int rank = 0;
+  MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+  if (rank != 0) {
+    auto& listeners = ::testing::UnitTest::GetInstance()->listeners();
+    delete listeners.Release(listeners.default_result_printer());
+  }
+  int result = 0;
+  {
+    Kokkos::ScopeGuard kokkos(argc, argv);
+    Tpetra::ScopeGuard tpetra(&argc, &argv);
+    result = RUN_ALL_TESTS();
+  }
+  // A test failing on any rank fails the run on every rank.
+  int global = 0;
+  MPI_Allreduce(&result, &global, 1, MPI_INT, MPI_MAX, MPI_COMM_WORLD);
+  MPI_Finalize();
+  return global;
+}
