@@ -1,0 +1,82 @@
+#include "io/run_output.hpp"
+
+#include <Teuchos_YamlParameterListHelpers.hpp>
+#include <filesystem>
+#include <sstream>
+
+#include "io/atomic_file.hpp"
+
+namespace bfemp {
+
+const std::vector<std::string>& diagnostics_columns() {
+  static const std::vector<std::string> cols = {
+      "step", "time", "dt", "kinetic", "elastic", "potential", "total_energy", "momentum_x",
+      "momentum_y", "momentum_z", "newton_iters", "linear_iters", "min_J", "assembly_s", "solve_s",
+      "step_s"};
+  return cols;
+}
+
+std::vector<double> diagnostics_row(const StepReport& r) {
+  return {static_cast<double>(r.step), r.time, r.dt, r.kinetic, r.elastic, r.potential,
+          r.total_energy(), r.momentum[0], r.momentum[1], r.momentum[2],
+          static_cast<double>(r.newton.iterations), static_cast<double>(r.newton.linear_iterations),
+          r.min_J, r.newton.assembly_s, r.newton.solve_s, r.step_s};
+}
+
+namespace {
+std::string prepare_dir(const std::string& dir) {
+  std::filesystem::create_directories(dir);
+  return dir;
+}
+}  // namespace
+
+template <int dim>
+RunOutput<dim>::RunOutput(const std::string& dir, const Scene& scene, const FemSimulation<dim>& sim)
+    : dir_(prepare_dir(dir)),
+      h5_(dir + "/bfemp.h5"),
+      xdmf_(dir + "/bfemp.xdmf", "bfemp.h5"),
+      csv_(dir + "/diagnostics.csv", diagnostics_columns(), {"step", "newton_iters", "linear_iters"}) {
+  std::ostringstream yaml;
+  yaml << std::showpoint;
+  Teuchos::writeParameterListToYamlOStream(scene.params, yaml);
+  write_file_atomically(dir + "/scene.yaml", yaml.str());
+  auto cells = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), sim.mesh().cells);
+  std::vector<long long> conn(cells.size());
+  for (std::size_t e = 0; e < cells.extent(0); ++e)
+    for (int a = 0; a <= dim; ++a) conn[e * (dim + 1) + a] = cells(e, a);
+  h5_.write_static("cells", conn.data(), cells.extent(0), dim + 1);
+}
+
+template <int dim>
+void RunOutput<dim>::write_frame(const FemSimulation<dim>& sim) {
+  const auto& mesh = sim.mesh();
+  const std::size_t nn = mesh.num_nodes(), ne = mesh.num_cells();
+  auto x = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), sim.positions());
+  auto v = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), sim.velocities());
+  Kokkos::View<double*, MemSpace> J("frame_J", ne), vm("frame_vm", ne);
+  sim.element_J(J);
+  sim.element_von_mises(vm);
+  auto Jh = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), J);
+  auto vmh = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), vm);
+  h5_.begin_frame(frame_, sim.time(), sim.step_index());
+  h5_.write_array("positions", x.data(), nn, dim);
+  h5_.write_array("velocities", v.data(), nn, dim);
+  h5_.write_array("von_mises", vmh.data(), ne, 1);
+  h5_.write_array("J", Jh.data(), ne, 1);
+  h5_.end_frame();
+  XdmfGrid g;
+  g.name = "fem";
+  g.group = Hdf5FrameWriter::frame_group_name(frame_);
+  g.topology = {dim == 2 ? "Triangle" : "Tetrahedron", ne, dim + 1, "/mesh/cells"};
+  g.num_nodes = nn;
+  g.dim = dim;
+  g.node_attributes = {{"velocity", "velocities", dim}};
+  g.cell_attributes = {{"von_mises", "von_mises", 1}, {"J", "J", 1}};
+  xdmf_.add_frame(XdmfFrame{sim.time(), {g}});
+  ++frame_;
+}
+
+template class RunOutput<2>;
+template class RunOutput<3>;
+
+}  // namespace bfemp

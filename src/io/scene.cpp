@@ -1,0 +1,270 @@
+#include "io/scene.hpp"
+
+#include <Teuchos_Array.hpp>
+#include <Teuchos_YamlParameterListHelpers.hpp>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "io/gmsh_reader.hpp"
+#include "io/scene_validate.hpp"
+#include "io/shape_mesher.hpp"
+
+namespace bfemp {
+
+using Teuchos::Array;
+using Teuchos::ParameterList;
+
+namespace {
+
+[[noreturn]] void bad(const std::string& key, const std::string& value, const std::string& expected) {
+  throw std::invalid_argument("scene key '" + key + "' = " + value + ": expected " + expected);
+}
+
+std::string num(double v) {
+  std::ostringstream s;
+  s << v;
+  return s.str();
+}
+
+Scene finish(ParameterList raw, const std::string& path, const std::string& base_dir,
+             const std::vector<std::string>& overrides) {
+  auto schema = scene_schema();
+  if (raw.name() != "bfemp")
+    throw std::invalid_argument("scene '" + path + "': top-level key '" + raw.name() +
+                                "', expected 'bfemp'");
+  for (const auto& o : overrides) apply_scene_override(raw, *schema, o);
+  validate_scene_list(raw, *schema, "");
+  Scene s;
+  s.path = path;
+  s.base_dir = base_dir;
+  s.params = raw;
+  const int dim = s.dim();
+  if (dim != 2 && dim != 3) bad("dimension", std::to_string(dim), "2 or 3");
+  const auto& time = raw.sublist("Time");
+  if (!(time.get<double>("dt") > 0)) bad("Time/dt", num(time.get<double>("dt")), "dt > 0 (s)");
+  if (!(time.get<double>("end time") > 0))
+    bad("Time/end time", num(time.get<double>("end time")), "a positive time (s)");
+  if (!(raw.sublist("Newton").get<double>("eps_d") > 0))
+    bad("Newton/eps_d", num(raw.sublist("Newton").get<double>("eps_d")), "eps_d > 0 (m/s)");
+  if (raw.sublist("Newton").get<int>("max iterations") < 1)
+    bad("Newton/max iterations", std::to_string(raw.sublist("Newton").get<int>("max iterations")), ">= 1");
+  if (raw.sublist("Output").get<int>("frame every") < 1)
+    bad("Output/frame every", std::to_string(raw.sublist("Output").get<int>("frame every")), ">= 1");
+  const auto g = raw.get<Array<double>>("gravity");
+  if (!g.empty() && static_cast<int>(g.size()) != dim)
+    bad("gravity", Teuchos::toString(g), std::to_string(dim) + " components");
+  const auto& mats = raw.sublist("Materials");
+  for (auto it = mats.begin(); it != mats.end(); ++it) {
+    const auto& m = mats.sublist(mats.name(it));
+    const std::string k = "Materials/" + mats.name(it) + "/";
+    if (!(m.get<double>("E") > 0)) bad(k + "E", num(m.get<double>("E")), "E > 0 (Pa)");
+    const double nu = m.get<double>("nu");
+    if (!(nu > -1 && nu < 0.5)) bad(k + "nu", num(nu), "a Poisson ratio in (-1, 0.5)");
+    if (!(m.get<double>("density") > 0)) bad(k + "density", num(m.get<double>("density")), "density > 0");
+  }
+  const auto& bodies = raw.sublist("FEM Bodies");
+  if (bodies.numParams() == 0) bad("FEM Bodies", "{}", "at least one body");
+  for (auto it = bodies.begin(); it != bodies.end(); ++it) {
+    const auto& b = bodies.sublist(bodies.name(it));
+    const std::string mname = b.get<std::string>("material");
+    if (!mats.isSublist(mname))
+      bad("FEM Bodies/" + bodies.name(it) + "/material", "'" + mname + "'", "the name of an entry of Materials");
+  }
+  return s;
+}
+
+std::array<double, 3> vec3(const Array<double>& a, int dim, const std::string& key) {
+  std::array<double, 3> v{0, 0, 0};
+  if (a.empty()) return v;
+  if (static_cast<int>(a.size()) != dim) bad(key, Teuchos::toString(a), std::to_string(dim) + " components");
+  for (int i = 0; i < dim; ++i) v[i] = a[i];
+  return v;
+}
+
+MeshData load_mesh(const ParameterList& mesh, const std::string& key, const std::string& base_dir, int dim) {
+  const std::string file = mesh.get<std::string>("file");
+  const std::string shape = mesh.get<std::string>("shape");
+  if (!file.empty()) {
+    std::filesystem::path p(file);
+    if (p.is_relative()) p = std::filesystem::path(base_dir) / p;
+    if (!std::filesystem::exists(p))
+      bad(key + "/file", "'" + file + "'", "an existing Gmsh .msh file (looked for " + p.string() + ")");
+    return read_gmsh_msh4(p.string(), dim);
+  }
+  if (shape == "none") bad(key, "{no file, shape none}", "a 'file' or a 'shape'");
+  ShapeSpec spec;
+  spec.kind = shape;
+  const auto c = mesh.get<Array<double>>("center");
+  spec.center.assign(c.begin(), c.end());
+  const auto s = mesh.get<Array<double>>("size");
+  spec.size.assign(s.begin(), s.end());
+  spec.inner_radius = mesh.get<double>("inner radius");
+  spec.outer_radius = mesh.get<double>("outer radius");
+  spec.element_size = mesh.get<double>("element size");
+  try {
+    return mesh_shape(spec, dim);
+  } catch (const std::invalid_argument& e) {
+    throw std::invalid_argument("scene key '" + key + "': " + e.what());
+  }
+}
+
+MotionSegment segment_from(const ParameterList& s, int dim, const std::string& key) {
+  MotionSegment seg;
+  const std::string type = s.get<std::string>("type");
+  seg.type = type == "velocity" ? MotionType::Velocity
+             : type == "rotation" ? MotionType::Rotation : MotionType::Fixed;
+  seg.duration = s.get<double>("duration");
+  if (!(seg.duration > 0)) bad(key + "/duration", num(seg.duration), "a positive duration (s)");
+  seg.velocity = vec3(s.get<Array<double>>("velocity"), dim, key + "/velocity");
+  seg.angular_velocity = s.get<double>("angular velocity");
+  seg.center = vec3(s.get<Array<double>>("center"), dim, key + "/center");
+  const auto ax = s.get<Array<double>>("axis");
+  if (!ax.empty()) {
+    if (ax.size() != 3) bad(key + "/axis", Teuchos::toString(ax), "3 components");
+    seg.axis = {ax[0], ax[1], ax[2]};
+    if (ax[0] * ax[0] + ax[1] * ax[1] + ax[2] * ax[2] == 0) bad(key + "/axis", "[0,0,0]", "a non-zero axis");
+  }
+  if (seg.type == MotionType::Velocity && s.get<Array<double>>("velocity").empty())
+    bad(key + "/velocity", "[]", std::to_string(dim) + " components for type velocity");
+  return seg;
+}
+
+}  // namespace
+
+RunControl Scene::run_control() const {
+  RunControl rc;
+  rc.end_time = params.sublist("Time").get<double>("end time");
+  rc.output_every = params.sublist("Output").get<int>("frame every");
+  rc.progress_every = params.sublist("Output").get<int>("progress every");
+  return rc;
+}
+
+Scene load_scene(const std::string& path, const std::vector<std::string>& overrides) {
+  std::ifstream in(path);
+  if (!in) throw std::invalid_argument("scene file '" + path + "': cannot be read");
+  std::stringstream ss;
+  ss << in.rdbuf();
+  const auto dir = std::filesystem::absolute(path).parent_path().string();
+  Scene s = load_scene_from_string(ss.str(), dir, overrides);
+  s.path = path;
+  return s;
+}
+
+Scene load_scene_from_string(const std::string& yaml, const std::string& base_dir,
+                             const std::vector<std::string>& overrides) {
+  Teuchos::RCP<ParameterList> raw;
+  try {
+    raw = Teuchos::getParametersFromYamlString(yaml);
+  } catch (const std::exception& e) {
+    throw std::invalid_argument(std::string("scene is not valid YAML: ") + e.what());
+  }
+  return finish(*raw, "", base_dir, overrides);
+}
+
+template <int dim>
+FemSetup<dim> build_fem_setup(const Scene& scene) {
+  const ParameterList& p = scene.params;
+  FemSetup<dim> setup;
+  std::vector<std::string> mat_names;
+  const auto& mats = p.sublist("Materials");
+  for (auto it = mats.begin(); it != mats.end(); ++it) {
+    const auto& m = mats.sublist(mats.name(it));
+    MaterialParams mp;
+    mp.model = m.get<std::string>("model") == "linear" ? MaterialModel::LinearElastic : MaterialModel::NeoHookean;
+    mp.lame = lame_from_young(m.get<double>("E"), m.get<double>("nu"));
+    mp.density = m.get<double>("density");
+    setup.materials.push_back(mp);
+    mat_names.push_back(mats.name(it));
+  }
+  const auto& bodies = p.sublist("FEM Bodies");
+  LO node_offset = 0;
+  for (auto it = bodies.begin(); it != bodies.end(); ++it) {
+    const std::string name = bodies.name(it);
+    const std::string key = "FEM Bodies/" + name;
+    const auto& b = bodies.sublist(name);
+    FemBodyInput in;
+    in.name = name;
+    in.mesh = load_mesh(b.sublist("Mesh"), key + "/Mesh", scene.base_dir, dim);
+    const std::string mname = b.get<std::string>("material");
+    in.material_index = static_cast<int>(std::find(mat_names.begin(), mat_names.end(), mname) - mat_names.begin());
+    setup.initial_velocity.push_back(vec3(b.get<Array<double>>("initial velocity"), dim, key + "/initial velocity"));
+    const auto& bcs = b.sublist("Boundary Conditions");
+    for (auto bit = bcs.begin(); bit != bcs.end(); ++bit) {
+      const std::string bkey = key + "/Boundary Conditions/" + bcs.name(bit);
+      const auto& bc = bcs.sublist(bcs.name(bit));
+      PrescribedMotion mo;
+      mo.name = name + "/" + bcs.name(bit);
+      const std::string set = bc.get<std::string>("node set");
+      const auto lo = bc.get<Array<double>>("box min"), hi = bc.get<Array<double>>("box max");
+      if (!set.empty()) {
+        auto f = in.mesh.node_sets.find(set);
+        if (f == in.mesh.node_sets.end()) {
+          std::string names;
+          for (const auto& kv : in.mesh.node_sets) names += " '" + kv.first + "'";
+          bad(bkey + "/node set", "'" + set + "'", "a node set of the mesh:" + (names.empty() ? " (none)" : names));
+        }
+        for (long long n : f->second) mo.nodes.push_back(node_offset + static_cast<LO>(n));
+      } else {
+        if (static_cast<int>(lo.size()) != dim || static_cast<int>(hi.size()) != dim)
+          bad(bkey, "{box min " + Teuchos::toString(lo) + ", box max " + Teuchos::toString(hi) + "}",
+              "a 'node set' or 'box min' and 'box max' with " + std::to_string(dim) + " components");
+        for (std::size_t n = 0; n < in.mesh.num_nodes(); ++n) {
+          bool inside = true;
+          for (int c = 0; c < dim; ++c) {
+            const double x = in.mesh.coords[n * dim + c];
+            inside = inside && x >= lo[c] && x <= hi[c];
+          }
+          if (inside) mo.nodes.push_back(node_offset + static_cast<LO>(n));
+        }
+      }
+      if (mo.nodes.empty()) bad(bkey, "(selection)", "at least one node in the selection");
+      const auto& motion = bc.sublist("Motion");
+      for (auto sit = motion.begin(); sit != motion.end(); ++sit)
+        mo.segments.push_back(segment_from(motion.sublist(motion.name(sit)), dim, bkey + "/Motion/" + motion.name(sit)));
+      if (mo.segments.empty()) mo.segments.push_back(MotionSegment{});  // fixed
+      setup.motions.push_back(std::move(mo));
+    }
+    node_offset += static_cast<LO>(in.mesh.num_nodes());
+    setup.bodies.push_back(std::move(in));
+  }
+  const auto& time = p.sublist("Time");
+  setup.dt = time.get<double>("dt");
+  if (time.get<std::string>("integrator") == "newmark") {
+    const auto& nm = time.sublist("Newmark");
+    setup.integrator = TimeIntegrator::newmark(nm.get<double>("alpha"), nm.get<double>("beta"), nm.get<double>("gamma"));
+  } else {
+    setup.integrator = TimeIntegrator::backward_euler();
+  }
+  setup.gravity = vec3(p.get<Array<double>>("gravity"), dim, "gravity");
+  setup.newton.eps_d = p.sublist("Newton").get<double>("eps_d");
+  setup.newton.max_iterations = p.sublist("Newton").get<int>("max iterations");
+  setup.linear_solver = p.sublist("Linear Solver");
+  return setup;
+}
+
+template FemSetup<2> build_fem_setup<2>(const Scene&);
+template FemSetup<3> build_fem_setup<3>(const Scene&);
+
+std::string scene_summary(const Scene& scene) {
+  const auto& p = scene.params;
+  std::ostringstream s;
+  const auto& t = p.sublist("Time");
+  s << "scene " << (scene.path.empty() ? "(string)" : scene.path) << ": " << p.get<int>("dimension")
+    << "D, " << t.get<std::string>("integrator") << ", dt " << t.get<double>("dt") << " s to "
+    << t.get<double>("end time") << " s, eps_d " << p.sublist("Newton").get<double>("eps_d") << " m/s\n";
+  const auto& bodies = p.sublist("FEM Bodies");
+  for (auto it = bodies.begin(); it != bodies.end(); ++it) {
+    const auto& b = bodies.sublist(bodies.name(it));
+    const auto& mesh = b.sublist("Mesh");
+    const auto& m = p.sublist("Materials").sublist(b.get<std::string>("material"));
+    s << "  FEM body '" << bodies.name(it) << "': "
+      << (mesh.get<std::string>("file").empty() ? mesh.get<std::string>("shape") : mesh.get<std::string>("file"))
+      << ", " << m.get<std::string>("model") << " E " << m.get<double>("E") << " nu " << m.get<double>("nu")
+      << " rho " << m.get<double>("density") << ", "
+      << b.sublist("Boundary Conditions").numParams() << " prescribed set(s)\n";
+  }
+  return s.str();
+}
+
+}  // namespace bfemp

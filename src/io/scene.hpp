@@ -1,0 +1,45 @@
+#pragma once
+// Scene files: YAML read into a Teuchos::ParameterList, validated against the
+// full schema (unknown keys, wrong types and bad values stop the run before the
+// first step with a message naming the key, the value and what was expected),
+// defaults filled in, and turned into the solver's set-up structures.
+#include <Teuchos_ParameterList.hpp>
+#include <string>
+#include <vector>
+
+#include "sim/fem_simulation.hpp"
+
+namespace bfemp {
+
+struct RunControl {
+  double end_time = 0;
+  int output_every = 1;     // steps between output frames
+  int progress_every = 10;  // steps between progress lines
+};
+
+struct Scene {
+  std::string path;                 // scene file ("" for strings)
+  std::string base_dir;             // directory mesh paths are relative to
+  Teuchos::ParameterList params;    // resolved: validated, defaults filled
+  int dim() const { return params.get<int>("dimension"); }
+  RunControl run_control() const;
+};
+
+// The schema with every key, default and doc string (top list "bfemp").
+Teuchos::RCP<const Teuchos::ParameterList> scene_schema();
+
+// Reads a YAML scene, applies `overrides` ("Time/dt=1e-3": path/to/key=value,
+// the value parsed as the existing key's type), validates it. Throws
+// std::invalid_argument with a message naming key, value and expectation.
+Scene load_scene(const std::string& path, const std::vector<std::string>& overrides = {});
+Scene load_scene_from_string(const std::string& yaml, const std::string& base_dir,
+                             const std::vector<std::string>& overrides = {});
+
+// Builds meshes (files or Gmsh shapes), materials, motions and solver settings.
+template <int dim>
+FemSetup<dim> build_fem_setup(const Scene& scene);
+
+// A one-paragraph summary for the start of a run.
+std::string scene_summary(const Scene& scene);
+
+}  // namespace bfemp

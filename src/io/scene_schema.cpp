@@ -1,0 +1,116 @@
+// The scene schema: every key with its default and documentation.
+#include <Teuchos_Array.hpp>
+#include <Teuchos_StandardParameterEntryValidators.hpp>
+
+#include "io/scene.hpp"
+#include "io/scene_validate.hpp"
+#include "solver/linear_solver.hpp"
+
+namespace bfemp {
+
+using Teuchos::Array;
+using Teuchos::ParameterList;
+using Teuchos::tuple;
+
+namespace {
+
+void choice(ParameterList& pl, const std::string& key, const std::string& def, const std::string& doc,
+            const Teuchos::ArrayView<const std::string>& values) {
+  pl.set(key, def, doc, Teuchos::rcp(new Teuchos::StringValidator(values)));
+}
+
+ParameterList material_schema() {
+  ParameterList m("material");
+  choice(m, "model", "neo-hookean", "constitutive model (paper Eq. 7, or small-strain linear)",
+         tuple<std::string>("neo-hookean", "linear"));
+  m.set("E", 1e6, "Young's modulus (Pa), > 0");
+  m.set("nu", 0.3, "Poisson ratio, in (-1, 0.5)");
+  m.set("density", 1000.0, "rest density (kg/m^3; kg/m^2 in 2D), > 0");
+  return m;
+}
+
+ParameterList segment_schema() {
+  ParameterList s("segment");
+  choice(s, "type", "fixed", "fixed, velocity (constant), or rotation (rigid, about axis through center)",
+         tuple<std::string>("fixed", "velocity", "rotation"));
+  s.set("duration", 1e300, "seconds this segment lasts; the next starts after it");
+  s.set("velocity", Array<double>(), "m/s, dim components (type velocity)");
+  s.set("angular velocity", 0.0, "rad/s about axis, right-handed (type rotation)");
+  s.set("center", Array<double>(), "m, dim components: a point on the rotation axis");
+  s.set("axis", Array<double>(), "rotation axis (3D; 2D rotates about z)");
+  return s;
+}
+
+ParameterList bc_schema() {
+  ParameterList b("boundary condition");
+  b.set("node set", std::string(""), "named node set of the mesh (physical group or shape set)");
+  b.set("box min", Array<double>(), "select nodes inside [box min, box max] (alternative to node set)");
+  b.set("box max", Array<double>(), "upper corner of the selection box");
+  b.sublist("Motion", false, "segments applied in order (any names; sorted by name)")
+      .disableRecursiveValidation();
+  return b;
+}
+
+ParameterList body_schema() {
+  ParameterList b("FEM body");
+  b.set("material", std::string(""), "name of an entry of Materials");
+  b.set("initial velocity", Array<double>(), "m/s, dim components (default 0)");
+  auto& mesh = b.sublist("Mesh", false, "a Gmsh MSH 4.1 file or a generated shape");
+  mesh.set("file", std::string(""), "path to a .msh (v4 ASCII) file, relative to the scene file");
+  choice(mesh, "shape", "none", "generated with the Gmsh API when no file is given",
+         tuple<std::string>("none", "rectangle", "box", "disk", "ring", "half-ring", "spherical-shell"));
+  mesh.set("center", Array<double>(), "m, dim components (default origin)");
+  mesh.set("size", Array<double>(), "rectangle [w, h] or box [a, b, c] (m)");
+  mesh.set("inner radius", 0.0, "m (ring, half-ring, spherical-shell)");
+  mesh.set("outer radius", 0.0, "m (disk, ring, half-ring, spherical-shell)");
+  mesh.set("element size", 0.0, "target edge length (m) for generated shapes");
+  b.sublist("Boundary Conditions", false, "prescribed node sets, one sublist each")
+      .disableRecursiveValidation();
+  return b;
+}
+
+}  // namespace
+
+const ParameterList& scene_child_schema(const std::string& container) {
+  static const ParameterList mat = material_schema();
+  static const ParameterList body = body_schema();
+  static const ParameterList bc = bc_schema();
+  static const ParameterList seg = segment_schema();
+  if (container == "Materials") return mat;
+  if (container == "FEM Bodies") return body;
+  if (container == "Boundary Conditions") return bc;
+  if (container == "Motion") return seg;
+  throw std::logic_error("no child schema for " + container);
+}
+
+bool scene_is_container(const std::string& name) {
+  return name == "Materials" || name == "FEM Bodies" || name == "Boundary Conditions" ||
+         name == "Motion";
+}
+
+Teuchos::RCP<const ParameterList> scene_schema() {
+  auto pl = Teuchos::rcp(new ParameterList("bfemp"));
+  pl->set("dimension", 2, "2 (triangles, plane strain) or 3 (tetrahedra)");
+  pl->set("gravity", Array<double>(), "m/s^2, dim components (default none)");
+  auto& time = pl->sublist("Time", false, "time stepping");
+  time.set("dt", 1e-3, "time step (s), > 0");
+  time.set("end time", 1e-2, "simulated time (s), > 0");
+  choice(time, "integrator", "backward-euler", "paper Eqs. 21-22",
+         tuple<std::string>("backward-euler", "newmark"));
+  auto& nm = time.sublist("Newmark", false, "Newmark parameters (paper Eq. 21)");
+  nm.set("alpha", 0.5, "");
+  nm.set("beta", 0.25, "");
+  nm.set("gamma", 0.5, "");
+  auto& newton = pl->sublist("Newton", false, "projected Newton (paper Algorithm 2)");
+  newton.set("eps_d", 1e-6, "stop when |p|_inf / dt < eps_d (m/s)");
+  newton.set("max iterations", 200, "iteration cap per step; reaching it is an error");
+  pl->set("Linear Solver", *linear_solver_schema(), "linear solver of each Newton iteration");
+  auto& out = pl->sublist("Output", false, "output frames and progress");
+  out.set("frame every", 10, "steps between HDF5/XDMF frames (frame 0 is the initial state)");
+  out.set("progress every", 10, "steps between progress lines (0: none)");
+  pl->sublist("Materials", false, "named materials").disableRecursiveValidation();
+  pl->sublist("FEM Bodies", false, "named FEM bodies").disableRecursiveValidation();
+  return pl;
+}
+
+}  // namespace bfemp

@@ -1,0 +1,238 @@
+#include "solver/linear_solver.hpp"
+
+#include <Amesos2.hpp>
+#include <BelosLinearProblem.hpp>
+#include <BelosPseudoBlockCGSolMgr.hpp>
+#include <BelosTpetraAdapter.hpp>
+#include <Ifpack2_Factory.hpp>
+#include <Teuchos_StandardParameterEntryValidators.hpp>
+#include <Tpetra_CrsMatrix.hpp>
+#include <Tpetra_Vector.hpp>
+#include <set>
+#include <sstream>
+
+#include "solver/solver_error.hpp"
+
+namespace bfemp {
+namespace {
+
+using Teuchos::ParameterList;
+using Teuchos::RCP;
+using Teuchos::rcp;
+
+const char* const kPrecNames[] = {"RELAXATION", "CHEBYSHEV", "RILUK", "SCHWARZ", "NONE"};
+
+// Ifpack2 validates only RELAXATION's list; the others ignore unknown keys, so
+// bfemp checks those against the keys each one reads (Ifpack2 13.2 sources).
+const std::set<std::string>& known_ifpack2_keys(const std::string& prec) {
+  static const std::set<std::string> cheb = {
+      "chebyshev: degree", "chebyshev: ratio eigenvalue", "chebyshev: min eigenvalue",
+      "chebyshev: max eigenvalue", "chebyshev: eigenvalue max iterations",
+      "chebyshev: assume matrix does not change", "chebyshev: zero starting solution",
+      "chebyshev: min diagonal value", "chebyshev: boost factor", "chebyshev: algorithm"};
+  static const std::set<std::string> riluk = {
+      "fact: iluk level-of-fill", "fact: relax value", "fact: absolute threshold",
+      "fact: relative threshold", "fact: type", "fact: iluk overalloc"};
+  static const std::set<std::string> schwarz = {
+      "schwarz: overlap level", "schwarz: inner preconditioner name",
+      "schwarz: inner preconditioner parameters", "schwarz: combine mode",
+      "schwarz: use reordering", "schwarz: reordering list", "schwarz: subdomain id",
+      "schwarz: filter singletons", "schwarz: num iterations", "schwarz: zero starting solution"};
+  static const std::set<std::string> none;
+  if (prec == "CHEBYSHEV") return cheb;
+  if (prec == "RILUK") return riluk;
+  if (prec == "SCHWARZ") return schwarz;
+  return none;
+}
+
+void check_ifpack2_keys(const std::string& prec, const ParameterList& list) {
+  if (prec == "RELAXATION" || prec == "NONE") return;  // RELAXATION validates itself
+  const auto& known = known_ifpack2_keys(prec);
+  for (auto it = list.begin(); it != list.end(); ++it) {
+    const std::string& key = list.name(it);
+    if (!known.count(key)) {
+      std::ostringstream msg;
+      msg << "scene key 'Linear Solver/CG/Ifpack2/" << key << "': not a parameter of the "
+          << prec << " preconditioner; expected one of:";
+      for (const auto& k : known) msg << " '" << k << "'";
+      throw std::invalid_argument(msg.str());
+    }
+  }
+}
+
+}  // namespace
+
+Teuchos::RCP<const Teuchos::ParameterList> linear_solver_schema() {
+  auto pl = rcp(new ParameterList("Linear Solver"));
+  Teuchos::setStringToIntegralParameter<int>(
+      "type", "Cholmod", "Cholmod or KLU2 (direct, 1 MPI rank only) or CG (Belos + Ifpack2)",
+      Teuchos::tuple<std::string>("Cholmod", "KLU2", "CG"), pl.get());
+  auto& cg = pl->sublist("CG", false, "Belos conjugate gradients with an Ifpack2 preconditioner");
+  cg.set("tolerance", 1e-12, "relative residual |b - A x| / |b| at which CG stops",
+         rcp(new Teuchos::EnhancedNumberValidator<double>(1e-16, 1e-1)));
+  cg.set("max iterations", 2000, "CG iteration cap; reaching it is an error",
+         rcp(new Teuchos::EnhancedNumberValidator<int>(1, 1000000)));
+  Teuchos::setStringToIntegralParameter<int>(
+      "preconditioner", "RELAXATION", "Ifpack2 preconditioner",
+      Teuchos::tuple<std::string>(kPrecNames[0], kPrecNames[1], kPrecNames[2], kPrecNames[3],
+                                  kPrecNames[4]),
+      &cg);
+  auto& ifp = cg.sublist("Ifpack2", false,
+                         "parameters passed to the Ifpack2 preconditioner (checked by bfemp)");
+  ifp.disableRecursiveValidation();
+  return pl;
+}
+
+LinearSolverKind linear_solver_kind(const ParameterList& resolved) {
+  const std::string t = resolved.get<std::string>("type");
+  if (t == "Cholmod") return LinearSolverKind::Cholmod;
+  if (t == "KLU2") return LinearSolverKind::KLU2;
+  return LinearSolverKind::CG;
+}
+
+const char* linear_solver_name(LinearSolverKind kind) {
+  switch (kind) {
+    case LinearSolverKind::Cholmod: return "Cholmod";
+    case LinearSolverKind::KLU2: return "KLU2";
+    default: return "CG";
+  }
+}
+
+struct LinearSolver::Impl {
+  using Direct = Amesos2::Solver<Matrix, MultiVec>;
+  using Prec = Ifpack2::Preconditioner<double, LO, GO, Node>;
+  RCP<const Comm> comm;
+  RCP<const Matrix> A;
+  RCP<Direct> direct;
+  bool symbolic_done = false;
+  RCP<Prec> prec;
+  std::string prec_name;
+  ParameterList ifpack2;
+  double cg_tol = 1e-12;
+  int cg_max_iters = 2000;
+};
+
+LinearSolver::LinearSolver(const ParameterList& params, const RCP<const Comm>& comm)
+    : kind_(linear_solver_kind(params)), impl_(new Impl) {
+  impl_->comm = comm;
+  if (kind_ != LinearSolverKind::CG && comm->getSize() > 1) {
+    std::ostringstream msg;
+    msg << "scene key 'Linear Solver/type' = '" << linear_solver_name(kind_)
+        << "': direct solvers run on 1 MPI rank only in this Trilinos (13.2: KLU2 gives "
+           "wrong answers and Cholmod throws on more ranks); this run has "
+        << comm->getSize() << " ranks. Expected 'CG' under MPI.";
+    throw std::invalid_argument(msg.str());
+  }
+  if (kind_ == LinearSolverKind::Cholmod && !Amesos2::query("Cholmod"))
+    throw std::invalid_argument(
+        "scene key 'Linear Solver/type' = 'Cholmod': this Trilinos has no Cholmod adapter "
+        "(needs Amesos2_ENABLE_Experimental); expected 'KLU2' or 'CG'");
+  const ParameterList& cg = params.sublist("CG");
+  impl_->cg_tol = cg.get<double>("tolerance");
+  impl_->cg_max_iters = cg.get<int>("max iterations");
+  impl_->prec_name = cg.get<std::string>("preconditioner");
+  impl_->ifpack2 = cg.sublist("Ifpack2");
+  if (impl_->prec_name == "SCHWARZ" && !impl_->ifpack2.isParameter("schwarz: combine mode"))
+    impl_->ifpack2.set("schwarz: combine mode", "ADD");  // 13.2 default (ZERO) is non-symmetric
+  if (kind_ == LinearSolverKind::CG) check_ifpack2_keys(impl_->prec_name, impl_->ifpack2);
+}
+
+LinearSolver::~LinearSolver() = default;
+
+std::string LinearSolver::describe() const {
+  if (kind_ != LinearSolverKind::CG) return std::string("Amesos2 ") + linear_solver_name(kind_);
+  std::ostringstream s;
+  s << "Belos CG (tol " << impl_->cg_tol << ", max " << impl_->cg_max_iters << ") + Ifpack2 "
+    << impl_->prec_name;
+  return s.str();
+}
+
+void LinearSolver::set_matrix(const RCP<const Matrix>& A) {
+  auto& m = *impl_;
+  m.A = A;
+  if (kind_ == LinearSolverKind::CG) {
+    m.prec = Teuchos::null;
+    if (m.prec_name != "NONE") {
+      m.prec = Ifpack2::Factory::create<Tpetra::RowMatrix<double, LO, GO, Node>>(m.prec_name, A);
+      try {
+        m.prec->setParameters(m.ifpack2);
+      } catch (const std::exception& e) {
+        throw std::invalid_argument("scene sublist 'Linear Solver/CG/Ifpack2' rejected by " +
+                                    m.prec_name + ": " + e.what());
+      }
+      m.prec->initialize();
+    }
+    return;
+  }
+  const std::string name = linear_solver_name(kind_);
+  m.direct = Amesos2::create<Matrix, MultiVec>(name, A);
+  auto p = Teuchos::parameterList("Amesos2");
+  p->sublist(name);  // Cholmod must see setParameters before its first factorisation
+  m.direct->setParameters(p);
+  m.symbolic_done = false;
+}
+
+LinearSolveStats LinearSolver::solve(const Vector& b, Vector& x) {
+  auto& m = *impl_;
+  if (m.A.is_null()) throw std::logic_error("LinearSolver::solve before set_matrix");
+  LinearSolveStats stats;
+  if (kind_ != LinearSolverKind::CG) {
+    try {
+      if (!m.symbolic_done) {
+        m.direct->symbolicFactorization();
+        m.symbolic_done = true;
+        stats.refactored = true;
+      }
+      m.direct->numericFactorization();
+      m.direct->solve(Teuchos::ptr(static_cast<MultiVec*>(&x)),
+                      Teuchos::ptr(static_cast<const MultiVec*>(&b)));
+    } catch (const std::exception& e) {
+      throw SolverError(std::string(linear_solver_name(kind_)) + " factorisation/solve failed: " +
+                        e.what());
+    }
+    // One residual check per solve: a direct solver that silently returns a
+    // wrong answer is a failure.
+    Vector r(b.getMap());
+    m.A->apply(x, r);
+    r.update(1.0, b, -1.0);
+    const double bn = b.norm2();
+    stats.achieved_tol = bn > 0 ? r.norm2() / bn : r.norm2();
+    stats.iterations = 1;
+    if (!(stats.achieved_tol < 1e-6))
+      throw SolverError(std::string(linear_solver_name(kind_)) +
+                        " solve is inaccurate: relative residual " +
+                        std::to_string(stats.achieved_tol));
+    return stats;
+  }
+  if (!m.prec.is_null()) m.prec->compute();
+  auto bp = Teuchos::parameterList();
+  bp->set("Convergence Tolerance", m.cg_tol);
+  bp->set("Maximum Iterations", m.cg_max_iters);
+  bp->set("Implicit Residual Scaling", "Norm of RHS");
+  bp->set("Explicit Residual Scaling", "Norm of RHS");
+  bp->set("Verbosity", Belos::Errors);
+  auto xp = Teuchos::rcpFromRef(static_cast<MultiVec&>(x));
+  auto bpv = Teuchos::rcpFromRef(static_cast<const MultiVec&>(b));
+  auto problem = rcp(new Belos::LinearProblem<double, MultiVec, Operator>(m.A, xp, bpv));
+  if (!m.prec.is_null()) problem->setLeftPrec(m.prec);
+  problem->setProblem();
+  Belos::PseudoBlockCGSolMgr<double, MultiVec, Operator> cg(problem, bp);
+  Belos::ReturnType ret;
+  try {
+    ret = cg.solve();
+  } catch (const std::exception& e) {
+    throw SolverError(std::string("CG failed (matrix not positive definite?): ") + e.what());
+  }
+  stats.iterations = cg.getNumIters();
+  stats.achieved_tol = cg.achievedTol();
+  if (ret != Belos::Converged) {
+    std::ostringstream msg;
+    msg << "CG did not converge: " << stats.iterations << " iterations, relative residual "
+        << stats.achieved_tol << " > tolerance " << m.cg_tol
+        << " (raise 'Linear Solver/CG/max iterations' or choose a stronger preconditioner)";
+    throw SolverError(msg.str());
+  }
+  return stats;
+}
+
+}  // namespace bfemp

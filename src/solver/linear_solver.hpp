@@ -1,0 +1,52 @@
+#pragma once
+// The linear-solver layer: Amesos2 (Cholmod, KLU2) or Belos CG with an
+// Ifpack2 preconditioner, configured by the scene's "Linear Solver" sublist.
+#include <Teuchos_ParameterList.hpp>
+#include <Teuchos_RCP.hpp>
+#include <memory>
+#include <string>
+
+#include "solver/tpetra_types.hpp"
+
+namespace bfemp {
+
+enum class LinearSolverKind { Cholmod, KLU2, CG };
+
+struct LinearSolveStats {
+  int iterations = 0;        // Krylov iterations (1 for a direct solve)
+  double achieved_tol = 0;   // relative residual reported by the solver
+  bool refactored = false;   // a symbolic factorisation happened in this call
+};
+
+// Schema of the "Linear Solver" sublist with defaults and documentation.
+Teuchos::RCP<const Teuchos::ParameterList> linear_solver_schema();
+LinearSolverKind linear_solver_kind(const Teuchos::ParameterList& resolved);
+const char* linear_solver_name(LinearSolverKind kind);
+
+class LinearSolver {
+ public:
+  // `params` is a resolved (validated) "Linear Solver" list. Throws
+  // std::invalid_argument when a direct solver is asked for on > 1 rank or
+  // when Belos/Ifpack2 keys are misspelled.
+  LinearSolver(const Teuchos::ParameterList& params, const Teuchos::RCP<const Comm>& comm);
+  ~LinearSolver();
+  LinearSolver(const LinearSolver&) = delete;
+  LinearSolver& operator=(const LinearSolver&) = delete;
+
+  // Declare the matrix whose values will change between solves. A matrix on
+  // a new graph triggers a new symbolic factorisation / preconditioner set-up.
+  void set_matrix(const Teuchos::RCP<const Matrix>& A);
+  // Solve A x = b with the current values of A. Throws SolverError on a failed
+  // factorisation or a Krylov solve that does not reach the tolerance.
+  LinearSolveStats solve(const Vector& b, Vector& x);
+
+  LinearSolverKind kind() const { return kind_; }
+  std::string describe() const;
+
+ private:
+  struct Impl;
+  LinearSolverKind kind_;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace bfemp

@@ -1,0 +1,220 @@
+#include "solver/newton.hpp"
+
+#include <Kokkos_Timer.hpp>
+#include <Tpetra_CrsMatrix.hpp>
+#include <Tpetra_Vector.hpp>
+#include <cmath>
+#include <limits>
+#include <sstream>
+
+#include "kernels/fem_elasticity.hpp"
+#include "solver/dof_graph.hpp"
+#include "solver/solver_error.hpp"
+
+namespace bfemp {
+
+using View1 = Kokkos::View<double*, MemSpace>;
+using CView1 = Kokkos::View<const double*, MemSpace>;
+
+template <int dim>
+struct NewtonSolver<dim>::Impl {
+  const FemMesh<dim>& mesh;
+  NewtonParams params;
+  Teuchos::RCP<const Map> map;
+  Teuchos::RCP<Matrix> A;
+  Vector b, p;
+  LinearSolver solver;
+  View1 grad, rhs, dx_prescribed, dir, trial;
+  Teuchos::RCP<Teuchos::ParameterList> fill_params;
+
+  Impl(const FemMesh<dim>& m, const Teuchos::RCP<const Comm>& comm,
+       const Teuchos::ParameterList& ls, NewtonParams np)
+      : mesh(m),
+        params(np),
+        map(Teuchos::rcp(new Map(static_cast<Tpetra::global_size_t>(m.num_nodes()) * dim, 0, comm))),
+        A(Teuchos::rcp(new Matrix(build_dof_graph<dim>(m, map)))),
+        b(map),
+        p(map),
+        solver(ls, comm) {
+    if (comm->getSize() > 1)
+      throw std::invalid_argument(
+          "the Newton solver runs on 1 MPI rank in this version (the distributed "
+          "assembly comes with the MPI issue); run without mpirun or with -np 1");
+    A->fillComplete();
+    solver.set_matrix(A);
+    const std::size_t n = static_cast<std::size_t>(m.num_nodes()) * dim;
+    grad = View1("newton_grad", n);
+    rhs = View1("newton_rhs", n);
+    dx_prescribed = View1("newton_dx_prescribed", n);
+    dir = View1("newton_dir", n);
+    trial = View1("newton_trial", n);
+    fill_params = Teuchos::parameterList();
+    fill_params->set("No Nonlocal Changes", true);
+  }
+
+  // Gradient, projected Hessian and right-hand side at x.
+  void assemble(const IncrementalPotential& ip, CView1 x) {
+    auto g = grad;
+    auto r = rhs;
+    auto dxp = dx_prescribed;
+    Kokkos::deep_copy(g, 0.0);
+    Kokkos::deep_copy(r, 0.0);
+    A->resumeFill();
+    A->setAllToScalar(0.0);
+    auto lcl = A->getLocalMatrixDevice();
+    fem_elastic_assemble<dim>(mesh, x, ip.h, g, lcl, ip.prescribed, dxp, r);
+    auto mass = ip.mass;
+    auto xhat = ip.x_hat;
+    auto pres = ip.prescribed;
+    Kokkos::parallel_for(
+        "newton_inertia", Kokkos::RangePolicy<ExecSpace>(0, g.extent(0)), KOKKOS_LAMBDA(const LO i) {
+          g(i) += mass(i) * (x(i) - xhat(i));
+          double diag = mass(i);
+          if (pres(i)) {
+            diag = 1.0;
+            r(i) = dxp(i);
+          } else {
+            r(i) -= g(i);
+          }
+          lcl.sumIntoValues(i, &i, 1, &diag, false, true);
+        });
+    A->fillComplete(fill_params);
+  }
+};
+
+template <int dim>
+double NewtonSolver<dim>::Energy::total() const {
+  return inertia + elastic;
+}
+
+template <int dim>
+NewtonSolver<dim>::NewtonSolver(const FemMesh<dim>& mesh, const Teuchos::RCP<const Comm>& comm,
+                                const Teuchos::ParameterList& ls, NewtonParams params)
+    : impl_(new Impl(mesh, comm, ls, params)) {}
+
+template <int dim>
+NewtonSolver<dim>::~NewtonSolver() = default;
+
+template <int dim>
+const LinearSolver& NewtonSolver<dim>::linear_solver() const {
+  return impl_->solver;
+}
+
+template <int dim>
+Teuchos::RCP<const Map> NewtonSolver<dim>::dof_map() const {
+  return impl_->map;
+}
+
+template <int dim>
+typename NewtonSolver<dim>::Energy NewtonSolver<dim>::energy(const IncrementalPotential& ip,
+                                                             CView1 x) const {
+  Energy E;
+  auto mass = ip.mass;
+  auto xhat = ip.x_hat;
+  Kokkos::parallel_reduce(
+      "newton_inertia_energy", Kokkos::RangePolicy<ExecSpace>(0, x.extent(0)),
+      KOKKOS_LAMBDA(const LO i, double& acc) {
+        const double d = x(i) - xhat(i);
+        acc += 0.5 * mass(i) * d * d;
+      },
+      E.inertia);
+  E.elastic = ip.h * fem_elastic_energy<dim>(impl_->mesh, x);
+  return E;
+}
+
+template <int dim>
+NewtonStats NewtonSolver<dim>::minimize(const IncrementalPotential& ip, View1 x) {
+  auto& m = *impl_;
+  NewtonStats st;
+  Kokkos::Timer timer;
+  auto dxp = m.dx_prescribed;
+  auto pres = ip.prescribed;
+  auto target = ip.target;
+  auto dir = m.dir;
+  auto trial = m.trial;
+  for (int it = 0; it < m.params.max_iterations; ++it) {
+    // Remaining offset of the prescribed DOFs.
+    double pres_left = 0;
+    Kokkos::parallel_reduce(
+        "newton_prescribed_offset", Kokkos::RangePolicy<ExecSpace>(0, x.extent(0)),
+        KOKKOS_LAMBDA(const LO i, double& acc) {
+          dxp(i) = pres(i) ? target(i) - x(i) : 0.0;
+          acc = std::fmax(acc, std::fabs(dxp(i)));
+        },
+        Kokkos::Max<double>(pres_left));
+
+    timer.reset();
+    m.assemble(ip, x);
+    Kokkos::fence();
+    st.assembly_s += timer.seconds();
+
+    timer.reset();
+    {
+      auto bv = Kokkos::subview(m.b.getLocalViewDevice(Tpetra::Access::OverwriteAll), Kokkos::ALL(), 0);
+      Kokkos::deep_copy(bv, m.rhs);
+    }
+    m.p.putScalar(0.0);
+    const LinearSolveStats ls = m.solver.solve(m.b, m.p);
+    st.linear_iterations += ls.iterations;
+    {
+      auto pv = Kokkos::subview(m.p.getLocalViewDevice(Tpetra::Access::ReadOnly), Kokkos::ALL(), 0);
+      Kokkos::deep_copy(dir, pv);
+    }
+    st.solve_s += timer.seconds();
+
+    timer.reset();
+    double p_inf = 0;
+    Kokkos::parallel_reduce(
+        "newton_dir_norm", Kokkos::RangePolicy<ExecSpace>(0, x.extent(0)),
+        KOKKOS_LAMBDA(const LO i, double& acc) {
+          if (pres(i)) dir(i) = dxp(i);  // exact, not the solver's rounding of it
+          acc = std::fmax(acc, std::fabs(dir(i)));
+        },
+        Kokkos::Max<double>(p_inf));
+    if (!std::isfinite(p_inf))
+      throw SolverError("Newton direction is not finite (linear solve produced NaN/Inf)");
+
+    const double a_max = fem_max_feasible_step<dim>(m.mesh, x, dir);
+    double alpha = std::min(1.0, 0.9 * a_max);
+    const bool converged = p_inf / ip.dt < m.params.eps_d && pres_left == 0.0;
+    // Armijo-type backtracking on E while the prescribed DOFs are at their
+    // targets; while they still move, E may rise and the filtered step is taken.
+    if (pres_left == 0.0 && !converged) {
+      const Energy E0 = energy(ip, x);
+      const double tol = 1e-14 * (std::abs(E0.inertia) + std::abs(E0.elastic));
+      while (true) {
+        Kokkos::parallel_for(
+            "newton_trial", Kokkos::RangePolicy<ExecSpace>(0, x.extent(0)),
+            KOKKOS_LAMBDA(const LO i) { trial(i) = x(i) + alpha * dir(i); });
+        const double E1 = energy(ip, trial).total();
+        if (E1 <= E0.total() + tol) break;
+        alpha *= 0.5;
+        if (alpha * p_inf < 1e-3 * m.params.eps_d * ip.dt) {
+          std::ostringstream msg;
+          msg << "line search stalled at Newton iteration " << it + 1 << " (step " << alpha
+              << ", |p|_inf/dt = " << p_inf / ip.dt << " m/s, eps_d = " << m.params.eps_d << ")";
+          throw SolverError(msg.str());
+        }
+      }
+    }
+    Kokkos::parallel_for(
+        "newton_update", Kokkos::RangePolicy<ExecSpace>(0, x.extent(0)), KOKKOS_LAMBDA(const LO i) {
+          x(i) = (pres(i) && alpha == 1.0) ? target(i) : x(i) + alpha * dir(i);
+        });
+    Kokkos::fence();
+    st.line_search_s += timer.seconds();
+    st.min_step = std::min(st.min_step, alpha);
+    st.iterations = it + 1;
+    if (on_iterate) on_iterate(x);
+    if (converged) return st;
+  }
+  std::ostringstream msg;
+  msg << "Newton did not converge in " << m.params.max_iterations
+      << " iterations (raise 'Newton/max iterations' or reduce dt)";
+  throw SolverError(msg.str());
+}
+
+template class NewtonSolver<2>;
+template class NewtonSolver<3>;
+
+}  // namespace bfemp
