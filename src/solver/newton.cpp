@@ -181,13 +181,23 @@ NewtonStats NewtonSolver<dim>::minimize(const IncrementalPotential& ip, View1 x)
     // targets; while they still move, E may rise and the filtered step is taken.
     if (pres_left == 0.0 && !converged) {
       const Energy E0 = energy(ip, x);
-      const double tol = 1e-14 * (std::abs(E0.inertia) + std::abs(E0.elastic));
+      const double scale = std::abs(E0.inertia) + std::abs(E0.elastic);
+      const double tol = 1e-13 * scale;  // round-off of the energy sums
+      auto grad = m.grad;
+      double gp = 0;  // directional derivative of E along p (< 0)
+      Kokkos::parallel_reduce(
+          "newton_grad_dot_p", Kokkos::RangePolicy<ExecSpace>(0, x.extent(0)),
+          KOKKOS_LAMBDA(const LO i, double& acc) { acc += pres(i) ? 0.0 : grad(i) * dir(i); }, gp);
       while (true) {
         Kokkos::parallel_for(
             "newton_trial", Kokkos::RangePolicy<ExecSpace>(0, x.extent(0)),
             KOKKOS_LAMBDA(const LO i) { trial(i) = x(i) + alpha * dir(i); });
         const double E1 = energy(ip, trial).total();
         if (E1 <= E0.total() + tol) break;
+        // Near the minimum the predicted decrease alpha |g.p| falls below what
+        // the energy sums resolve; the energy cannot judge the step there, and
+        // the (filtered) Newton step is taken.
+        if (alpha * std::abs(gp) < 1e-11 * scale) break;
         alpha *= 0.5;
         if (alpha * p_inf < 1e-3 * m.params.eps_d * ip.dt) {
           std::ostringstream msg;
