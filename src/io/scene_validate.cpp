@@ -96,7 +96,7 @@ void validate_scene_list(ParameterList& list, const ParameterList& schema, const
                                       "': expected a sublist (a named " + child.name() + ")");
         validate_scene_list(sub.sublist(cname), child, join(join(path, key), cname));
       }
-    } else {
+    } else if (schema.sublist(key).numParams() > 0) {  // empty schema: free-form (Ifpack2)
       validate_scene_list(sub, schema.sublist(key), join(path, key));
     }
   }

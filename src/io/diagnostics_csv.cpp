@@ -1,0 +1,67 @@
+#include "io/diagnostics_csv.hpp"
+
+#include <cerrno>
+#include <cmath>
+#include <cstring>
+#include <stdexcept>
+#include <utility>
+
+namespace bfemp {
+
+DiagnosticsCsv::DiagnosticsCsv(const std::string& path, std::vector<std::string> columns,
+                               const std::set<std::string>& integer_columns)
+    : path_(path), columns_(std::move(columns)) {
+  const std::string where = "diagnostics file '" + path_ + "': ";
+  if (columns_.empty()) throw std::invalid_argument(where + "no columns, expected at least one");
+  std::set<std::string> seen;
+  for (const std::string& c : columns_) {
+    if (c.empty() || c.find_first_of(",\"\r\n") != std::string::npos)
+      throw std::invalid_argument(where + "column name '" + c +
+                                  "': expected non-empty, without ',', '\"' or line breaks");
+    if (!seen.insert(c).second)
+      throw std::invalid_argument(where + "column name '" + c + "' repeated");
+  }
+  for (const std::string& c : integer_columns)
+    if (!seen.count(c))
+      throw std::invalid_argument(where + "integer column '" + c + "' is not one of the columns");
+  for (const std::string& c : columns_) integer_.push_back(integer_columns.count(c) > 0);
+
+  file_ = std::fopen(path_.c_str(), "w");
+  if (!file_)
+    throw std::runtime_error(where + "cannot open for writing (" + std::strerror(errno) + ")");
+  std::string header;
+  for (std::size_t i = 0; i < columns_.size(); ++i) header += (i ? "," : "") + columns_[i];
+  put(header + "\n");
+}
+
+DiagnosticsCsv::~DiagnosticsCsv() {
+  if (file_) std::fclose(file_);
+}
+
+void DiagnosticsCsv::write_row(const std::vector<double>& values) {
+  if (values.size() != columns_.size())
+    throw std::invalid_argument("diagnostics file '" + path_ + "': row has " +
+                                std::to_string(values.size()) + " values, expected " +
+                                std::to_string(columns_.size()) + " (one per column)");
+  std::string row;
+  char buf[40];
+  for (std::size_t i = 0; i < values.size(); ++i) {
+    const double v = values[i];
+    const bool integral = std::isfinite(v) && v == std::floor(v) && std::abs(v) < 1e18;
+    if (integer_[i] && integral)
+      std::snprintf(buf, sizeof buf, "%lld", static_cast<long long>(v));
+    else
+      std::snprintf(buf, sizeof buf, "%.17g", v);
+    row += (i ? "," : "");
+    row += buf;
+  }
+  put(row + "\n");
+}
+
+void DiagnosticsCsv::put(const std::string& text) {
+  if (std::fwrite(text.data(), 1, text.size(), file_) != text.size() || std::fflush(file_) != 0)
+    throw std::runtime_error("diagnostics file '" + path_ + "': write failed (" +
+                             std::strerror(errno) + ")");
+}
+
+}  // namespace bfemp

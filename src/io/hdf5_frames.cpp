@@ -1,0 +1,300 @@
+#include "io/hdf5_frames.hpp"
+
+#include <hdf5.h>
+
+#include <cstdio>
+#include <stdexcept>
+#include <type_traits>
+
+static_assert(std::is_same<hid_t, std::int64_t>::value, "hid_t is stored as std::int64_t");
+
+namespace bfemp {
+namespace {
+
+// Suppresses HDF5's automatic error printing while alive, then restores it.
+class QuietErrors {
+ public:
+  QuietErrors() {
+    H5Eget_auto2(H5E_DEFAULT, &func_, &data_);
+    H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
+  }
+  ~QuietErrors() { H5Eset_auto2(H5E_DEFAULT, func_, data_); }
+  QuietErrors(const QuietErrors&) = delete;
+  QuietErrors& operator=(const QuietErrors&) = delete;
+
+ private:
+  H5E_auto2_t func_ = nullptr;
+  void* data_ = nullptr;
+};
+
+herr_t collect_error(unsigned n, const H5E_error2_t* err, void* out) {
+  std::string& s = *static_cast<std::string*>(out);
+  if (n > 0) s += "; ";
+  s += std::string(err->func_name ? err->func_name : "?") + ": " + (err->desc ? err->desc : "");
+  return 0;
+}
+
+// Must run before any other HDF5 call: each API call clears the stack.
+[[noreturn]] void fail(const std::string& file, const std::string& what) {
+  std::string stack;
+  H5Ewalk2(H5E_DEFAULT, H5E_WALK_DOWNWARD, collect_error, &stack);
+  throw std::runtime_error("HDF5 file '" + file + "': " + what +
+                           (stack.empty() ? std::string() : " [" + stack + "]"));
+}
+
+template <class T>
+T check(T value, const std::string& file, const std::string& what) {
+  if (value < 0) fail(file, what);
+  return value;
+}
+
+// Owning hid_t, closed with its matching H5?close.
+class Handle {
+ public:
+  Handle(hid_t id, herr_t (*closer)(hid_t)) : id_(id), closer_(closer) {}
+  ~Handle() {
+    if (id_ >= 0) closer_(id_);
+  }
+  Handle(const Handle&) = delete;
+  Handle& operator=(const Handle&) = delete;
+  hid_t get() const { return id_; }
+
+ private:
+  hid_t id_;
+  herr_t (*closer_)(hid_t);
+};
+
+// File access without HDF5 file locking (see the header).
+hid_t make_fapl(const std::string& file) {
+  const hid_t fapl = check(H5Pcreate(H5P_FILE_ACCESS), file, "cannot create file access list");
+#if H5_VERSION_GE(1, 10, 7)
+  if (H5Pset_file_locking(fapl, 0, 1) < 0) {
+    H5Pclose(fapl);
+    fail(file, "cannot disable file locking");
+  }
+#endif
+  return fapl;
+}
+
+void write_scalar_attribute(hid_t loc, const char* name, hid_t file_type, hid_t mem_type,
+                            const void* value, const std::string& file,
+                            const std::string& object) {
+  const std::string what = "cannot write attribute '" + std::string(name) + "' of '" + object + "'";
+  Handle space(check(H5Screate(H5S_SCALAR), file, what), H5Sclose);
+  Handle attr(check(H5Acreate2(loc, name, file_type, space.get(), H5P_DEFAULT, H5P_DEFAULT),
+                    file, what),
+              H5Aclose);
+  check(H5Awrite(attr.get(), mem_type, value), file, what);
+}
+
+template <class T>
+std::vector<T> read_any(const std::string& file, const std::string& path,
+                        std::vector<std::size_t>* shape, hid_t mem_type) {
+  QuietErrors quiet;
+  Handle fapl(make_fapl(file), H5Pclose);
+  Handle f(check(H5Fopen(file.c_str(), H5F_ACC_RDONLY, fapl.get()), file,
+                 "cannot open for reading"),
+           H5Fclose);
+  const std::string what = "cannot read dataset '" + path + "'";
+  Handle d(check(H5Dopen2(f.get(), path.c_str(), H5P_DEFAULT), file, what), H5Dclose);
+  Handle space(check(H5Dget_space(d.get()), file, what), H5Sclose);
+  const int rank = check(H5Sget_simple_extent_ndims(space.get()), file, what);
+  std::vector<hsize_t> dims(static_cast<std::size_t>(rank));
+  if (rank > 0) check(H5Sget_simple_extent_dims(space.get(), dims.data(), nullptr), file, what);
+  std::size_t total = 1;
+  for (hsize_t n : dims) total *= static_cast<std::size_t>(n);
+  std::vector<T> out(total);
+  if (total > 0)
+    check(H5Dread(d.get(), mem_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, out.data()), file, what);
+  if (shape) shape->assign(dims.begin(), dims.end());
+  return out;
+}
+
+}  // namespace
+
+std::string Hdf5FrameWriter::frame_group_name(int index) {
+  if (index < 0)
+    throw std::invalid_argument("HDF5 frame index " + std::to_string(index) +
+                                ": expected >= 0");
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "/frame_%06d", index);
+  return buf;
+}
+
+Hdf5FrameWriter::Hdf5FrameWriter(const std::string& path) : path_(path) {
+  QuietErrors quiet;
+  Handle fapl(make_fapl(path_), H5Pclose);
+  file_ = check(H5Fcreate(path_.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, fapl.get()), path_,
+                "cannot create file");
+}
+
+Hdf5FrameWriter::~Hdf5FrameWriter() {
+  try {
+    close();
+  } catch (...) {
+    close_handles();
+  }
+}
+
+void Hdf5FrameWriter::close_handles() noexcept {
+  QuietErrors quiet;
+  if (frame_ >= 0) H5Gclose(frame_);
+  if (mesh_ >= 0) H5Gclose(mesh_);
+  if (file_ >= 0) H5Fclose(file_);
+  frame_ = mesh_ = file_ = -1;
+}
+
+void Hdf5FrameWriter::close() {
+  if (file_ < 0) return;
+  if (frame_ >= 0) end_frame();
+  QuietErrors quiet;
+  if (mesh_ >= 0) {
+    const hid_t mesh = mesh_;
+    mesh_ = -1;
+    check(H5Gclose(mesh), path_, "cannot close group '/mesh'");
+  }
+  const hid_t file = file_;
+  file_ = -1;
+  check(H5Fclose(file), path_, "cannot close file");
+}
+
+void Hdf5FrameWriter::begin_frame(int index, double time, long step) {
+  const std::string name = frame_group_name(index);
+  if (file_ < 0) throw std::runtime_error("HDF5 file '" + path_ + "': begin_frame after close");
+  if (frame_ >= 0)
+    throw std::runtime_error("HDF5 file '" + path_ + "': begin_frame('" + name +
+                             "') while frame '" + frame_name_ + "' is still open");
+  QuietErrors quiet;
+  if (check(H5Lexists(file_, name.c_str() + 1, H5P_DEFAULT), path_, "cannot query '" + name + "'") > 0)
+    throw std::runtime_error("HDF5 file '" + path_ + "': frame group '" + name + "' already exists");
+  frame_ = check(H5Gcreate2(file_, name.c_str(), H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), path_,
+                 "cannot create group '" + name + "'");
+  frame_name_ = name;
+  const long long step64 = step, index64 = index;
+  write_scalar_attribute(frame_, "time", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, &time, path_, name);
+  write_scalar_attribute(frame_, "step", H5T_STD_I64LE, H5T_NATIVE_LLONG, &step64, path_, name);
+  write_scalar_attribute(frame_, "index", H5T_STD_I64LE, H5T_NATIVE_LLONG, &index64, path_, name);
+}
+
+void Hdf5FrameWriter::end_frame() {
+  if (frame_ < 0)
+    throw std::runtime_error("HDF5 file '" + path_ + "': end_frame without an open frame");
+  QuietErrors quiet;
+  const hid_t group = frame_;
+  frame_ = -1;
+  check(H5Gclose(group), path_, "cannot close group '" + frame_name_ + "'");
+  check(H5Fflush(file_, H5F_SCOPE_GLOBAL), path_, "cannot flush after '" + frame_name_ + "'");
+}
+
+void Hdf5FrameWriter::write_array(const std::string& name, const double* data,
+                                  std::size_t rows, std::size_t cols) {
+  if (frame_ < 0)
+    throw std::runtime_error("HDF5 file '" + path_ + "': dataset '" + name +
+                             "' written outside begin_frame/end_frame");
+  write_dataset(frame_, frame_name_, name, false, data, rows, cols);
+}
+
+void Hdf5FrameWriter::write_array(const std::string& name, const long long* data,
+                                  std::size_t rows, std::size_t cols) {
+  if (frame_ < 0)
+    throw std::runtime_error("HDF5 file '" + path_ + "': dataset '" + name +
+                             "' written outside begin_frame/end_frame");
+  write_dataset(frame_, frame_name_, name, true, data, rows, cols);
+}
+
+std::int64_t Hdf5FrameWriter::mesh_group() {
+  if (file_ < 0) throw std::runtime_error("HDF5 file '" + path_ + "': write after close");
+  if (mesh_ < 0) {
+    QuietErrors quiet;
+    mesh_ = check(H5Gcreate2(file_, "/mesh", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), path_,
+                  "cannot create group '/mesh'");
+  }
+  return mesh_;
+}
+
+void Hdf5FrameWriter::flush(const std::string& after) {
+  QuietErrors quiet;
+  check(H5Fflush(file_, H5F_SCOPE_GLOBAL), path_, "cannot flush after '" + after + "'");
+}
+
+void Hdf5FrameWriter::write_static(const std::string& name, const double* data,
+                                   std::size_t rows, std::size_t cols) {
+  write_dataset(mesh_group(), "/mesh", name, false, data, rows, cols);
+  flush("/mesh/" + name);
+}
+
+void Hdf5FrameWriter::write_static(const std::string& name, const long long* data,
+                                   std::size_t rows, std::size_t cols) {
+  write_dataset(mesh_group(), "/mesh", name, true, data, rows, cols);
+  flush("/mesh/" + name);
+}
+
+void Hdf5FrameWriter::write_dataset(std::int64_t loc, const std::string& loc_name,
+                                    const std::string& name, bool integer, const void* data,
+                                    std::size_t rows, std::size_t cols) {
+  const std::string full = loc_name + "/" + name;
+  if (name.empty() || name.find('/') != std::string::npos || name == "." || name == "..")
+    throw std::invalid_argument("HDF5 file '" + path_ + "': dataset name '" + name +
+                                "' in '" + loc_name + "': expected a non-empty name without '/'");
+  if (cols == 0 || (data == nullptr && rows > 0))
+    throw std::invalid_argument("HDF5 file '" + path_ + "': dataset '" + full + "' with " +
+                                std::to_string(rows) + "x" + std::to_string(cols) +
+                                (cols == 0 ? " values: expected cols >= 1" : " values and no data"));
+  QuietErrors quiet;
+  const std::string what = "cannot write dataset '" + full + "'";
+  if (check(H5Lexists(loc, name.c_str(), H5P_DEFAULT), path_, what) > 0)
+    throw std::runtime_error("HDF5 file '" + path_ + "': dataset '" + full + "' already exists");
+  const hsize_t dims[2] = {static_cast<hsize_t>(rows), static_cast<hsize_t>(cols)};
+  Handle space(check(H5Screate_simple(cols == 1 ? 1 : 2, dims, nullptr), path_, what), H5Sclose);
+  const hid_t file_type = integer ? H5T_STD_I64LE : H5T_IEEE_F64LE;
+  const hid_t mem_type = integer ? H5T_NATIVE_LLONG : H5T_NATIVE_DOUBLE;
+  Handle dset(check(H5Dcreate2(loc, name.c_str(), file_type, space.get(), H5P_DEFAULT,
+                               H5P_DEFAULT, H5P_DEFAULT),
+                    path_, what),
+              H5Dclose);
+  if (rows > 0)
+    check(H5Dwrite(dset.get(), mem_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, data), path_, what);
+}
+
+std::vector<double> read_dataset(const std::string& file, const std::string& path,
+                                 std::vector<std::size_t>* shape) {
+  return read_any<double>(file, path, shape, H5T_NATIVE_DOUBLE);
+}
+
+std::vector<long long> read_dataset_int(const std::string& file, const std::string& path,
+                                        std::vector<std::size_t>* shape) {
+  return read_any<long long>(file, path, shape, H5T_NATIVE_LLONG);
+}
+
+double read_attribute(const std::string& file, const std::string& object,
+                      const std::string& name) {
+  QuietErrors quiet;
+  Handle fapl(make_fapl(file), H5Pclose);
+  Handle f(check(H5Fopen(file.c_str(), H5F_ACC_RDONLY, fapl.get()), file,
+                 "cannot open for reading"),
+           H5Fclose);
+  const std::string what = "cannot read attribute '" + name + "' of '" + object + "'";
+  Handle attr(check(H5Aopen_by_name(f.get(), object.c_str(), name.c_str(), H5P_DEFAULT,
+                                    H5P_DEFAULT),
+                    file, what),
+              H5Aclose);
+  Handle space(check(H5Aget_space(attr.get()), file, what), H5Sclose);
+  if (check(H5Sget_simple_extent_npoints(space.get()), file, what) != 1)
+    throw std::runtime_error("HDF5 file '" + file + "': attribute '" + name + "' of '" + object +
+                             "' is not a scalar");
+  double value = 0.0;
+  check(H5Aread(attr.get(), H5T_NATIVE_DOUBLE, &value), file, what);
+  return value;
+}
+
+bool dataset_exists(const std::string& file, const std::string& path) {
+  QuietErrors quiet;
+  Handle fapl(make_fapl(file), H5Pclose);
+  Handle f(check(H5Fopen(file.c_str(), H5F_ACC_RDONLY, fapl.get()), file,
+                 "cannot open for reading"),
+           H5Fclose);
+  Handle d(H5Dopen2(f.get(), path.c_str(), H5P_DEFAULT), H5Dclose);
+  return d.get() >= 0;
+}
+
+}  // namespace bfemp

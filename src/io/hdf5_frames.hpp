@@ -1,0 +1,90 @@
+#pragma once
+// Time-series output in one HDF5 file (HDF5 C API):
+//
+//   /mesh/<name>            static datasets (e.g. "cells"), written once
+//   /frame_000000/<name>    per-frame datasets (e.g. "positions", "velocity")
+//     attributes: time (float64), step (int64), index (int64)
+//
+// Arrays are row-major, `rows x cols` (a 1-D dataset when cols == 1); doubles
+// are stored as IEEE float64 LE, integers as int64 LE.
+//
+// Parallel use: this is a serial writer. In an MPI run only rank 0 constructs
+// it and writes data it has gathered; no other rank may touch the file.
+//
+// Durability: end_frame() and write_static() call H5Fflush, so the file on
+// disk is complete and readable after every finished frame even while the
+// writer stays open (a crash loses at most the frame in progress). The file
+// is created without HDF5 file locking so that a viewer can open it while the
+// simulation is still running.
+//
+// Every failing HDF5 call becomes a std::runtime_error naming the file, the
+// object and the HDF5 error stack; HDF5's automatic error printing is
+// suppressed for the duration of each call.
+#include <cstddef>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace bfemp {
+
+class Hdf5FrameWriter {
+ public:
+  // Creates (or truncates) the file.
+  explicit Hdf5FrameWriter(const std::string& path);
+  // Closes any open frame and the file; errors are swallowed (call close() to
+  // see them).
+  ~Hdf5FrameWriter();
+  Hdf5FrameWriter(const Hdf5FrameWriter&) = delete;
+  Hdf5FrameWriter& operator=(const Hdf5FrameWriter&) = delete;
+
+  // Creates group frame_group_name(index) with attributes time, step, index.
+  // Throws if a frame is already open, index < 0 or the group exists.
+  void begin_frame(int index, double time, long step);
+  // Datasets in the open frame; throws if no frame is open or name exists.
+  void write_array(const std::string& name, const double* data, std::size_t rows,
+                   std::size_t cols);
+  void write_array(const std::string& name, const long long* data, std::size_t rows,
+                   std::size_t cols);
+  // Datasets in "/mesh" (created on first use), flushed immediately.
+  void write_static(const std::string& name, const double* data, std::size_t rows,
+                    std::size_t cols);
+  void write_static(const std::string& name, const long long* data, std::size_t rows,
+                    std::size_t cols);
+  // Closes the frame group and flushes the file.
+  void end_frame();
+  // Ends an open frame and closes the file, throwing on error. Idempotent.
+  void close();
+
+  const std::string& path() const { return path_; }
+  bool frame_open() const { return frame_ >= 0; }
+  // "/frame_%06d".
+  static std::string frame_group_name(int index);
+
+ private:
+  void write_dataset(std::int64_t loc, const std::string& loc_name, const std::string& name,
+                     bool integer, const void* data, std::size_t rows, std::size_t cols);
+  void close_handles() noexcept;
+  std::int64_t mesh_group();  // "/mesh", created on first use
+  void flush(const std::string& after);
+
+  std::string path_;
+  std::int64_t file_ = -1;   // hid_t
+  std::int64_t frame_ = -1;  // open frame group
+  std::int64_t mesh_ = -1;   // "/mesh" group
+  std::string frame_name_;
+};
+
+// Read helpers (tests, post-processing). `path` is the absolute object path in
+// the file, e.g. "/frame_000001/positions". The shape (1 or 2 entries) is
+// returned through `shape` when non-null. Integer data are converted.
+std::vector<double> read_dataset(const std::string& file, const std::string& path,
+                                 std::vector<std::size_t>* shape);
+std::vector<long long> read_dataset_int(const std::string& file, const std::string& path,
+                                        std::vector<std::size_t>* shape);
+// Scalar numeric attribute `name` of the object (group or dataset) `object`.
+double read_attribute(const std::string& file, const std::string& object,
+                      const std::string& name);
+// True if `path` names an existing dataset in `file`.
+bool dataset_exists(const std::string& file, const std::string& path);
+
+}  // namespace bfemp
