@@ -1,0 +1,154 @@
+// Bad scenes stop before the first step with a message naming the key, the
+// value and what was expected.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <regex>
+
+#include "common/fem_fixtures.hpp"
+#include "io/scene.hpp"
+
+using namespace bfemp;
+
+namespace {
+
+const std::string kScene = R"(%YAML 1.1
+---
+bfemp:
+  dimension: 2
+  Time:
+    dt: 1.0e-3
+    end time: 1.0e-2
+  Linear Solver:
+    type: CG
+    CG:
+      preconditioner: CHEBYSHEV
+  Materials:
+    soft:
+      E: 1.0e5
+      nu: 0.3
+      density: 1000.0
+  FEM Bodies:
+    block:
+      material: soft
+      Mesh:
+        MESH
+      Boundary Conditions:
+        base:
+          node set: bottom
+...
+)";
+
+const std::string kShape =
+    "shape: rectangle\n        center: [0.5, 0.5]\n        size: [1.0, 1.0]\n        element size: 0.5";
+
+std::string scene_with(const std::string& from, const std::string& to, const std::string& mesh = kShape) {
+  std::string s = std::regex_replace(kScene, std::regex("MESH"), mesh);
+  if (!from.empty()) {
+    const auto pos = s.find(from);
+    EXPECT_NE(pos, std::string::npos) << from;
+    s.replace(pos, from.size(), to);
+  }
+  return s;
+}
+
+// Loads and builds the scene as the driver does before step 1; returns the
+// error message ("" if none).
+std::string error_of(const std::string& yaml, const std::vector<std::string>& sets = {}) {
+  try {
+    Scene s = load_scene_from_string(yaml, std::string(BFEMP_SOURCE_DIR) + "/tests/data", sets);
+    FemSimulation<2> sim(build_fem_setup<2>(s), bfemp::testing::comm());
+  } catch (const std::invalid_argument& e) {
+    return e.what();
+  } catch (const std::exception& e) {
+    return std::string("OTHER: ") + e.what();
+  }
+  return "";
+}
+
+void expect_message(const std::string& msg, std::initializer_list<const char*> parts) {
+  ASSERT_FALSE(msg.empty()) << "the scene was accepted";
+  for (const char* p : parts) EXPECT_NE(msg.find(p), std::string::npos) << "'" << p << "' missing in: " << msg;
+}
+
+}  // namespace
+
+TEST(SceneErrors, ValidSceneIsAccepted) { EXPECT_EQ(error_of(scene_with("", "")), ""); }
+
+TEST(SceneErrors, UnknownKey) {
+  expect_message(error_of(scene_with("end time", "end tme")), {"Time/end tme", "unknown key", "'end time'"});
+  expect_message(error_of(scene_with("material: soft", "materal: soft")), {"FEM Bodies/block/materal", "unknown"});
+}
+
+TEST(SceneErrors, WrongType) {
+  expect_message(error_of(scene_with("dt: 1.0e-3", "dt: fast")), {"Time/dt", "fast", "wrong type", "real number"});
+}
+
+TEST(SceneErrors, NonPositiveYoungsModulusAndDensity) {
+  expect_message(error_of(scene_with("E: 1.0e5", "E: -5.0")), {"Materials/soft/E", "-5", "E > 0"});
+  expect_message(error_of(scene_with("density: 1000.0", "density: 0.0")), {"Materials/soft/density", "0", "> 0"});
+}
+
+TEST(SceneErrors, PoissonRatioOutsideRange) {
+  expect_message(error_of(scene_with("nu: 0.3", "nu: 0.5")), {"Materials/soft/nu", "0.5", "(-1, 0.5)"});
+  expect_message(error_of(scene_with("nu: 0.3", "nu: -1.0")), {"Materials/soft/nu", "-1", "(-1, 0.5)"});
+}
+
+TEST(SceneErrors, NonPositiveTimeStep) {
+  expect_message(error_of(scene_with("dt: 1.0e-3", "dt: 0.0")), {"Time/dt", "0", "dt > 0"});
+  expect_message(error_of(scene_with("", ""), {"Time/dt=-1e-3"}), {"Time/dt", "-0.001", "dt > 0"});
+}
+
+TEST(SceneErrors, MissingMeshFile) {
+  expect_message(error_of(scene_with("", "", "file: no_such_mesh.msh")),
+                 {"FEM Bodies/block/Mesh/file", "no_such_mesh.msh", "existing Gmsh"});
+}
+
+TEST(SceneErrors, UnreadableMeshFile) {
+  const std::string path = std::string(BFEMP_BINARY_DIR) + "/garbage.msh";
+  std::ofstream(path) << "this is not a mesh\n";
+  const std::string msg = error_of(scene_with("", "", "file: " + path));
+  expect_message(msg, {"garbage.msh", "MSH 4.1"});
+}
+
+TEST(SceneErrors, DegenerateElementInRestMesh) {
+  // Three collinear nodes make a zero-area triangle.
+  const std::string path = std::string(BFEMP_BINARY_DIR) + "/degenerate.msh";
+  std::ofstream(path) << "$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$Nodes\n1 4 1 4\n2 1 0 4\n1\n2\n3\n4\n"
+                         "0 0 0\n1 0 0\n2 0 0\n0 1 0\n$EndNodes\n$Elements\n1 2 1 2\n2 1 2 2\n"
+                         "1 1 2 4\n2 1 2 3\n$EndElements\n";
+  expect_message(error_of(scene_with("", "", "file: " + path)), {"degenerate"});
+}
+
+TEST(SceneErrors, InvertedElementRejectedByTheFemMesh) {
+  MeshData m;
+  m.dim = 2;
+  m.coords = {0, 0, 1, 0, 0, 1};
+  m.cells = {0, 2, 1};  // clockwise
+  MaterialParams mp;
+  mp.lame = lame_from_young(1e5, 0.3);
+  mp.density = 1000;
+  try {
+    build_fem_mesh<2>({FemBodyInput{"tri", m, 0}}, {mp});
+    FAIL() << "an inverted rest element was accepted";
+  } catch (const std::invalid_argument& e) {
+    expect_message(e.what(), {"'tri'", "element 0", "inverted"});
+  }
+}
+
+TEST(SceneErrors, BadEnumAndSolverKeys) {
+  expect_message(error_of(scene_with("type: CG", "type: GMRES")), {"Linear Solver/type", "GMRES", "'CG'"});
+  expect_message(error_of(scene_with("preconditioner: CHEBYSHEV",
+                                     "preconditioner: CHEBYSHEV\n      Ifpack2:\n        'chebyshev: degre': 3")),
+                 {"chebyshev: degre", "CHEBYSHEV"});
+}
+
+TEST(SceneErrors, UnknownNodeSetAndMaterial) {
+  expect_message(error_of(scene_with("node set: bottom", "node set: floor")), {"node set", "floor", "'bottom'"});
+  expect_message(error_of(scene_with("material: soft", "material: steel")), {"FEM Bodies/block/material", "steel"});
+}
+
+TEST(SceneErrors, OverrideOfUnknownKey) {
+  expect_message(error_of(scene_with("", ""), {"Time/dtt=1.0"}), {"Time/dtt", "unknown key"});
+}
