@@ -1,21 +1,19 @@
 #pragma once
 // Line-search inversion bound: the first step alpha > 0 at which a simplex
-// with edge matrix T(alpha) = T + alpha dT degenerates, i.e. the smallest
-// positive root of the polynomial det(T + alpha dT) (quadratic in 2D, cubic
-// in 3D).
+// with edge matrix T + alpha dT degenerates, i.e. the smallest positive root
+// of det(T + alpha dT) (quadratic in 2D, cubic in 3D).
 //
-// Method. Inputs are first scaled by exact powers of two. The coefficients
-// c_k (c_0 = det T, c_dim = det dT, mixed determinants in between) are built
-// exactly from column-mixed determinants; a coefficient below its own rounding
-// bound (8u times the matching mixed permanent of |T|, |dT|) is set to zero,
-// which lowers the degree for rank-deficient dT. The positive roots of p'
-// (stable quadratic formula) split (0, inf) into intervals on which p is
-// monotone; they are visited in order, and the first one whose right end has
-// det <= 0 is refined by safeguarded Newton/bisection down to a few ulps. The
-// sign tests evaluate det(T + alpha dT) directly (not the coefficients), which
-// keeps structured cases (dT = -s T, diagonal matrices) exact. A local minimum
-// whose value lies within the running rounding bound of that evaluation is a
-// tangency: the refinement then stops where det drops into that bound.
+// Method. T and dT are scaled by exact powers of two. The coefficients c_k
+// (c_0 = det T, c_dim = det dT, mixed determinants between) are built from
+// column-mixed determinants; one below its rounding bound (8u times the
+// matching mixed permanent) is set to zero, lowering the degree for
+// rank-deficient dT. The positive roots of p' (stable quadratic formula)
+// split (0, inf) into intervals where p is monotone. Sign tests evaluate
+// det(T + alpha dT) directly (exact in structured cases such as dT = -s T)
+// minus a running bound on its rounding error, so "positive" is certified.
+// The first interval end not certified positive brackets the answer, which
+// Newton / bisection refines to a few ulps, starting from the closed-form
+// root when the degree is <= 2. A tangency (double root) is caught alike.
 #include <cmath>
 #include <limits>
 
@@ -88,10 +86,11 @@ struct DetPolynomial {
       if (std::abs(c[k]) <= 8.0 * kRoundoff * bound[k]) c[k] = 0.0;
   }
 
-  // det(T + a dT) evaluated directly; `err` receives a bound on its rounding
-  // error (entry rounding through the cofactors, cofactor/sum rounding through
-  // the permanent, plus second-order terms).
-  KOKKOS_INLINE_FUNCTION double eval(double a, double& err) const {
+  // det(T + a dT) evaluated directly, minus a bound on the rounding error of
+  // that evaluation (cofactor and sum rounding through the permanent of |M|,
+  // entry rounding through the cofactors and higher-order terms): a positive
+  // value certifies det(T + a dT) > 0.
+  KOKKOS_INLINE_FUNCTION double certified(double a) const {
     Mat<dim> M, W;
     for (int j = 0; j < dim; ++j)
       for (int i = 0; i < dim; ++i) {
@@ -102,10 +101,20 @@ struct DetPolynomial {
     const Mat<dim> C = cofactors<dim>(M);
     double d = 0.0;
     for (int i = 0; i < dim; ++i) d += M(i, 0) * C(i, 0);
+    // Entry errors |E| <= 2u W: det M - det(M - E) has first-order terms
+    // sum |E||C|, then terms with two columns of E (and one of M), det E.
     const double u = kRoundoff;
-    err = 8.0 * u * (abs_permanent<dim>(M) + W.cwiseProduct(C.cwiseAbs()).sum()) +
-          64.0 * u * u * abs_permanent<dim>(W);
-    return d;
+    double higher = 16.0 * u * u * abs_permanent<dim>(W);
+    if constexpr (dim == 3) {
+      double mixed = 0.0;
+      for (int l = 0; l < 3; ++l) {
+        Mat<dim> Wl = W;
+        Wl.col(l) = M.col(l);
+        mixed += abs_permanent<dim>(Wl);
+      }
+      higher = 16.0 * u * u * mixed + 128.0 * u * u * u * abs_permanent<dim>(W);
+    }
+    return d - (8.0 * u * (abs_permanent<dim>(M) + W.cwiseProduct(C.cwiseAbs()).sum()) + higher);
   }
 
   KOKKOS_INLINE_FUNCTION double slope(double a) const {
@@ -114,71 +123,87 @@ struct DetPolynomial {
 
   // Positive roots of p' in ascending order; returns how many (0..2).
   KOKKOS_INLINE_FUNCTION int critical_points(double x[2]) const {
-    const double A = 3.0 * c[3], B = 2.0 * c[2], C = c[1];
-    double r[2];
-    int m = 0;
+    const double A = 3.0 * c[3], B = 2.0 * c[2], C = c[1], disc = B * B - 4.0 * A * C;
+    double r[2] = {-1.0, -1.0};
     if (A == 0.0) {
-      if (B != 0.0) r[m++] = -C / B;
-    } else {
-      const double disc = B * B - 4.0 * A * C;
-      if (disc >= 0.0) {
-        const double q = -0.5 * (B + std::copysign(std::sqrt(disc), B));
-        r[m++] = q / A;
-        r[m++] = q != 0.0 ? C / q : 0.0;
-      }
+      if (B != 0.0) r[0] = -C / B;
+    } else if (disc >= 0.0) {
+      const double q = -0.5 * (B + std::copysign(std::sqrt(disc), B));
+      r[0] = q / A;
+      r[1] = q != 0.0 ? C / q : 0.0;
     }
+    if (r[1] < r[0]) { const double t = r[0]; r[0] = r[1]; r[1] = t; }
     int n = 0;
-    for (int i = 0; i < m; ++i)
-      if (r[i] > 0.0 && std::isfinite(r[i])) x[n++] = r[i];
-    if (n == 2 && x[1] < x[0]) { const double t = x[0]; x[0] = x[1]; x[1] = t; }
+    for (double ri : r)
+      if (ri > 0.0 && std::isfinite(ri)) x[n++] = ri;
     return n;
+  }
+
+  // Closed-form start when the effective degree is <= 2: smallest positive
+  // root of c0 + c1 a + c2 a^2 by the stable quadratic formula, else NaN.
+  KOKKOS_INLINE_FUNCTION double quadratic_guess() const {
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    if (c[3] != 0.0) return nan;
+    if (c[2] == 0.0) return c[1] != 0.0 ? -c[0] / c[1] : nan;
+    const double disc = c[1] * c[1] - 4.0 * c[2] * c[0];
+    if (disc < 0.0) return nan;
+    const double q = -0.5 * (c[1] + std::copysign(std::sqrt(disc), c[1]));
+    const double r1 = q / c[2], r2 = q != 0.0 ? c[0] / q : nan;
+    return r1 > 0.0 && (!(r2 > 0.0) || r1 < r2) ? r1 : r2;
   }
 
   KOKKOS_INLINE_FUNCTION static double middle(double lo, double hi) {
     return (lo > 0.0 && hi > 8.0 * lo) ? std::sqrt(lo) * std::sqrt(hi) : 0.5 * (lo + hi);
   }
 
-  // h(a) = det(T + a dT) (minus its rounding bound if `shifted`) with
-  // h(lo) > 0 >= h(hi): safeguarded Newton/bisection; returns the final lo,
-  // where h is still positive.
-  KOKKOS_INLINE_FUNCTION double refine(double lo, double hi, bool shifted) const {
-    double x = middle(lo, hi), width_before = hi - lo;
-    for (int it = 0; it < 2000; ++it) {
-      double err;
-      double h = eval(x, err);
-      if (shifted) h -= err;
-      if (h > 0.0) lo = x; else hi = x;
-      const double width = hi - lo;
-      if (width <= 4.0 * kRoundoff * hi) break;
-      double xn = x - h / slope(x);
-      const double tiny = 2.0 * kRoundoff * hi;
-      if (std::abs(xn - x) < tiny) xn = h > 0.0 ? x + tiny : x - tiny;  // straddle the root
-      if (!(xn > lo && xn < hi) || width > 0.5 * width_before) xn = middle(lo, hi);
-      width_before = width;
-      x = xn;
+  // h = certified(), h(lo) > 0 >= h(hi). Newton from the best point while its
+  // step is large (bisection if it leaves the bracket or the bracket has not
+  // halved in two steps); then aim just across the Newton estimate, doubling
+  // the offset while probes land on the same side (h is flat or noisy within
+  // a few ulps of the crossing). Returns the final lo, where h is positive.
+  KOKKOS_INLINE_FUNCTION double refine(double lo, double h_lo, double hi, double h_hi) const {
+    double x = quadratic_guess();
+    if (!(x > lo && x < hi)) x = lo + (hi - lo) * (h_lo / (h_lo - h_hi));  // regula falsi
+    if (!(x > lo && x < hi)) x = middle(lo, hi);
+    double best_x = x, best_h = std::numeric_limits<double>::infinity();
+    double width1 = 2.0 * (hi - lo), width2 = width1, probe = 0.0;
+    for (int it = 0; it < 400; ++it) {
+      const double hx = certified(x);
+      if ((hx > 0.0) != (best_h > 0.0)) probe = 0.0;  // landed across
+      if (hx > 0.0) lo = x; else hi = x;
+      if (std::abs(hx) <= std::abs(best_h)) { best_x = x; best_h = hx; }
+      const double tol = 2.0 * kRoundoff * hi, width = hi - lo;
+      if (width <= 2.0 * tol) break;
+      const double step = best_h / slope(best_x), estimate = best_x - step;
+      if (std::abs(step) < 0.25 * width) {
+        probe = probe > 0.0 ? 2.0 * probe : tol;
+        x = best_h > 0.0 ? std::fmax(estimate, lo) + probe : std::fmin(estimate, hi) - probe;
+      } else {
+        x = width > 0.5 * width2 ? middle(lo, hi) : estimate;
+      }
+      if (!(x > lo && x < hi)) x = middle(lo, hi);
+      width2 = width1;
+      width1 = width;
     }
     return lo;
   }
 
   KOKKOS_INLINE_FUNCTION double smallest_positive_root() const {
     constexpr double inf = std::numeric_limits<double>::infinity();
-    double err;
-    if (!(eval(0.0, err) > 0.0)) return 0.0;
+    double prev = 0.0, h_prev = certified(0.0);
+    if (!(h_prev > 0.0)) return 0.0;  // det T <= 0 up to rounding
     int n = dim;
     while (n > 0 && c[n] == 0.0) --n;
     if (n == 0) return inf;
+    // p is monotone between critical points: the first right end where
+    // positivity is no longer certified brackets the root (or a tangency).
     double x[2];
     const int nx = critical_points(x);
-    double prev = 0.0;
     for (int i = 0; i < nx; ++i) {
-      const double fx = eval(x[i], err);
-      if (fx <= 0.0) return refine(prev, x[i], false);
-      if (fx <= err) {  // touches zero within rounding: tangency
-        double err_prev;
-        const double fp = eval(prev, err_prev);
-        return fp > err_prev ? refine(prev, x[i], true) : prev;
-      }
+      const double hx = certified(x[i]);
+      if (hx <= 0.0) return refine(prev, h_prev, x[i], hx);
       prev = x[i];
+      h_prev = hx;
     }
     // Monotone on (prev, inf): a root exists iff p -> -inf.
     if (c[n] > 0.0) return inf;
@@ -186,8 +211,10 @@ struct DetPolynomial {
     for (int k = 0; k < n; ++k)
       bound = std::fmax(bound, 2.0 * std::pow(std::abs(c[k] / c[n]), 1.0 / (n - k)));
     double hi = 2.0 * std::fmax(bound, prev);
-    for (int it = 0; it < 64 && std::isfinite(hi); ++it, hi *= 4.0)
-      if (eval(hi, err) <= 0.0) return refine(prev, hi, false);
+    for (int it = 0; it < 64 && std::isfinite(hi); ++it, hi *= 4.0) {
+      const double h_hi = certified(hi);
+      if (h_hi <= 0.0) return refine(prev, h_prev, hi, h_hi);
+    }
     return inf;
   }
 };
@@ -196,29 +223,27 @@ struct DetPolynomial {
 
 // Smallest alpha > 0 with det(T + alpha dT) = 0, for T = (x1-x0, x2-x0, ...)
 // the edge matrix of a simplex and dT the same built from the search
-// direction. Requires det T > 0.
-// Returns:
-//   +infinity  if det(T + alpha dT) > 0 for every alpha > 0 (never inverts);
-//   0          if det T <= 0, T or dT are not finite, or det T itself is zero
-//              within rounding and the polynomial touches zero later;
-//   otherwise a value alpha* with det(T + a dT) > 0 on [0, alpha*] up to
-//   rounding, at most a few ulps below the computed crossing (never above it);
-//   at a tangency (double root) the answer is the start of the interval where
-//   det is zero within rounding, i.e. slightly conservative.
+// direction (det T > 0 expected). Returns:
+//   +infinity  if det(T + alpha dT) > 0 for every alpha > 0 (never inverts),
+//              or the only roots lie beyond the double range;
+//   0          if T or dT are not finite, or det T is not positive beyond
+//              rounding (already inverted or degenerate);
+//   otherwise  alpha* <= the smallest positive root, where det(T + alpha* dT)
+//              is still certified positive: a few ulps below a simple root
+//              (relative u times its condition number), and for a double or
+//              triple root the start of the band where det is zero within
+//              rounding (about sqrt(u) resp. cbrt(u) relative, worst case).
 template <int dim>
 KOKKOS_INLINE_FUNCTION double smallest_positive_det_root(const Mat<dim>& T, const Mat<dim>& dT) {
-  if (!T.allFinite() || !dT.allFinite()) return 0.0;
+  constexpr double inf = std::numeric_limits<double>::infinity();
   const double t_max = T.cwiseAbs().maxCoeff(), d_max = dT.cwiseAbs().maxCoeff();
-  if (t_max == 0.0) return 0.0;
-  if (d_max == 0.0)
-    return det_root_detail::determinant<dim>(T) > 0.0 ? std::numeric_limits<double>::infinity()
-                                                      : 0.0;
+  if (!T.allFinite() || !dT.allFinite() || t_max == 0.0) return 0.0;
+  if (d_max == 0.0) return det_root_detail::determinant<dim>(T) > 0.0 ? inf : 0.0;
   int et = 0, ed = 0;
-  std::frexp(t_max, &et);
-  std::frexp(d_max, &ed);
-  const det_root_detail::DetPolynomial<dim> poly(std::ldexp(1.0, -et) * T, std::ldexp(1.0, -ed) * dT);
-  // det(T + a dT) = 2^(dim et) det(Ts + (a 2^(ed - et)) dTs): a = beta 2^(et - ed).
-  return std::ldexp(poly.smallest_positive_root(), et - ed);
+  std::frexp(t_max, &et), std::frexp(d_max, &ed);
+  // det(T + a dT) = 2^(dim et) det(Ts + beta dTs) with beta = a 2^(ed - et).
+  const det_root_detail::DetPolynomial<dim> p(std::ldexp(1.0, -et) * T, std::ldexp(1.0, -ed) * dT);
+  return std::ldexp(p.smallest_positive_root(), et - ed);
 }
 
 }  // namespace bfemp

@@ -19,18 +19,19 @@ FemMesh<dim> build_fem_mesh(const std::vector<FemBodyInput>& bodies,
     n_cells += b.mesh.num_cells();
   }
   FemMesh<dim> m;
-  m.cells = decltype(m.cells)("fem_cells", n_cells);
-  m.Dm_inv = decltype(m.Dm_inv)("fem_Dm_inv", n_cells);
-  m.rest_volume = decltype(m.rest_volume)("fem_rest_volume", n_cells);
-  m.material = decltype(m.material)("fem_material", n_cells);
-  m.materials = decltype(m.materials)("fem_materials", materials.size());
+  auto& el = m.elements;
+  el.nodes = decltype(el.nodes)("fem_cells", n_cells);
+  el.g = decltype(el.g)("fem_shape_gradients", n_cells);
+  el.volume = decltype(el.volume)("fem_rest_volume", n_cells);
+  el.material = decltype(el.material)("fem_material", n_cells);
+  el.materials = decltype(el.materials)("fem_materials", materials.size());
   m.node_mass = decltype(m.node_mass)("fem_node_mass", n_nodes);
   m.rest_position = decltype(m.rest_position)("fem_rest_position", n_nodes * dim);
-  auto cells = Kokkos::create_mirror_view(m.cells);
-  auto Dm_inv = Kokkos::create_mirror_view(m.Dm_inv);
-  auto vol = Kokkos::create_mirror_view(m.rest_volume);
-  auto mat = Kokkos::create_mirror_view(m.material);
-  auto mats = Kokkos::create_mirror_view(m.materials);
+  auto cells = Kokkos::create_mirror_view(el.nodes);
+  auto grad_N = Kokkos::create_mirror_view(el.g);
+  auto vol = Kokkos::create_mirror_view(el.volume);
+  auto mat = Kokkos::create_mirror_view(el.material);
+  auto mats = Kokkos::create_mirror_view(el.materials);
   auto mass = Kokkos::create_mirror_view(m.node_mass);
   auto X = Kokkos::create_mirror_view(m.rest_position);
   Kokkos::deep_copy(mass, 0.0);
@@ -58,9 +59,15 @@ FemMesh<dim> build_fem_mesh(const std::vector<FemBodyInput>& bodies,
             << "); expected positive volume";
         throw std::invalid_argument(msg.str());
       }
+      // grad N_a = row a-1 of Dm^-1 (a >= 1); grad N_0 = -sum of the others.
       const Mat<dim> inv = Dm.inverse();
-      for (int i = 0; i < dim; ++i)
-        for (int j = 0; j < dim; ++j) Dm_inv(ce, i, j) = inv(i, j);
+      for (int j = 0; j < dim; ++j) {
+        grad_N(ce, 0, j) = 0;
+        for (int a = 1; a < nv; ++a) {
+          grad_N(ce, a, j) = inv(a - 1, j);
+          grad_N(ce, 0, j) -= inv(a - 1, j);
+        }
+      }
       vol(ce) = fact * det;
       mat(ce) = b.material_index;
       for (int a = 0; a < nv; ++a) mass(cells(ce, a)) += rho * vol(ce) / nv;
@@ -70,11 +77,11 @@ FemMesh<dim> build_fem_mesh(const std::vector<FemBodyInput>& bodies,
     node0 += static_cast<LO>(md.num_nodes());
     cell0 += static_cast<LO>(md.num_cells());
   }
-  Kokkos::deep_copy(m.cells, cells);
-  Kokkos::deep_copy(m.Dm_inv, Dm_inv);
-  Kokkos::deep_copy(m.rest_volume, vol);
-  Kokkos::deep_copy(m.material, mat);
-  Kokkos::deep_copy(m.materials, mats);
+  Kokkos::deep_copy(el.nodes, cells);
+  Kokkos::deep_copy(el.g, grad_N);
+  Kokkos::deep_copy(el.volume, vol);
+  Kokkos::deep_copy(el.material, mat);
+  Kokkos::deep_copy(el.materials, mats);
   Kokkos::deep_copy(m.node_mass, mass);
   Kokkos::deep_copy(m.rest_position, X);
   return m;

@@ -2,10 +2,12 @@
 // All FEM bodies of a scene concatenated into one simplex mesh on Kokkos
 // Views: connectivity, rest shape (inverse edge matrices, volumes), lumped
 // masses and per-element materials. Built once; read by the kernels.
+// Element e's F = sum_a x_a grad N_a^T with grad N_a from the rest shape.
 #include <string>
 #include <vector>
 
 #include "core/types.hpp"
+#include "kernels/deformation_energy.hpp"
 #include "io/mesh_data.hpp"
 #include "materials/material.hpp"
 
@@ -14,20 +16,18 @@ namespace bfemp {
 template <int dim>
 struct FemMesh {
   static constexpr int nv = dim + 1;  // vertices per simplex
-  Kokkos::View<LO* [nv], MemSpace> cells;
-  Kokkos::View<double* [dim][dim], MemSpace> Dm_inv;  // inverse rest edge matrix
-  Kokkos::View<double*, MemSpace> rest_volume;
-  Kokkos::View<int*, MemSpace> material;               // index into `materials`
-  Kokkos::View<MaterialParams*, MemSpace> materials;
-  Kokkos::View<double*, MemSpace> node_mass;           // lumped, per node
-  Kokkos::View<double*, MemSpace> rest_position;       // node-interleaved, n*dim
+  // Elements as deformation stencils: nodes = connectivity, g = rest
+  // shape-function gradients, volume = rest volume.
+  DeformationStencils<dim, nv> elements;
+  Kokkos::View<double*, MemSpace> node_mass;      // lumped, per node
+  Kokkos::View<double*, MemSpace> rest_position;  // node-interleaved, n*dim
 
   // Host bookkeeping per body (node and element ranges, names).
   struct BodyRange { std::string name; LO first_node, num_nodes, first_cell, num_cells; };
   std::vector<BodyRange> bodies;
 
   LO num_nodes() const { return static_cast<LO>(node_mass.extent(0)); }
-  LO num_cells() const { return static_cast<LO>(cells.extent(0)); }
+  LO num_cells() const { return elements.size(); }
 };
 
 struct FemBodyInput {

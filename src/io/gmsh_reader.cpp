@@ -5,7 +5,6 @@
 #include <cstdio>
 #include <cstring>
 #include <map>
-#include <set>
 #include <stdexcept>
 #include <string_view>
 #include <unordered_map>
@@ -48,28 +47,23 @@ class MshCursor {
     skip_space(false);
     return pos_ < text_.size() && text_[pos_] != '\n';
   }
+  template <class T>
+  T number(const char* what, const char* kind) {
+    const std::string_view t = token(what);
+    T v{};
+    const auto r = std::from_chars(t.data(), t.data() + t.size(), v);
+    if (r.ec != std::errc() || r.ptr != t.data() + t.size())
+      fail(std::string("expected ") + kind + " (" + what + "), found '" + std::string(t) + "'");
+    return v;
+  }
   std::string_view token(const char* what) {
     if (at_end()) fail(std::string("unexpected end of file (truncated?) while reading ") + what);
     const std::size_t start = pos_;
     while (pos_ < text_.size() && !is_space(text_[pos_])) ++pos_;
     return std::string_view(text_).substr(start, pos_ - start);
   }
-  long long integer(const char* what) {
-    const std::string_view t = token(what);
-    long long v = 0;
-    const auto r = std::from_chars(t.data(), t.data() + t.size(), v);
-    if (r.ec != std::errc() || r.ptr != t.data() + t.size())
-      fail(std::string("expected an integer (") + what + "), found '" + std::string(t) + "'");
-    return v;
-  }
-  double real(const char* what) {
-    const std::string_view t = token(what);
-    double v = 0;
-    const auto r = std::from_chars(t.data(), t.data() + t.size(), v);
-    if (r.ec != std::errc() || r.ptr != t.data() + t.size())
-      fail(std::string("expected a number (") + what + "), found '" + std::string(t) + "'");
-    return v;
-  }
+  long long integer(const char* what) { return number<long long>(what, "an integer"); }
+  double real(const char* what) { return number<double>(what, "a number"); }
   // A double-quoted name (may contain spaces).
   std::string quoted(const char* what) {
     if (at_end() || text_[pos_] != '"') fail(std::string("expected a quoted ") + what);

@@ -87,14 +87,17 @@ void write_scalar_attribute(hid_t loc, const char* name, hid_t file_type, hid_t 
   check(H5Awrite(attr.get(), mem_type, value), file, what);
 }
 
+// Read-only id of `file` (close with H5Fclose).
+hid_t open_read_only(const std::string& file) {
+  Handle fapl(make_fapl(file), H5Pclose);
+  return check(H5Fopen(file.c_str(), H5F_ACC_RDONLY, fapl.get()), file, "cannot open for reading");
+}
+
 template <class T>
 std::vector<T> read_any(const std::string& file, const std::string& path,
                         std::vector<std::size_t>* shape, hid_t mem_type) {
   QuietErrors quiet;
-  Handle fapl(make_fapl(file), H5Pclose);
-  Handle f(check(H5Fopen(file.c_str(), H5F_ACC_RDONLY, fapl.get()), file,
-                 "cannot open for reading"),
-           H5Fclose);
+  Handle f(open_read_only(file), H5Fclose);
   const std::string what = "cannot read dataset '" + path + "'";
   Handle d(check(H5Dopen2(f.get(), path.c_str(), H5P_DEFAULT), file, what), H5Dclose);
   Handle space(check(H5Dget_space(d.get()), file, what), H5Sclose);
@@ -186,20 +189,21 @@ void Hdf5FrameWriter::end_frame() {
   check(H5Fflush(file_, H5F_SCOPE_GLOBAL), path_, "cannot flush after '" + frame_name_ + "'");
 }
 
+std::int64_t Hdf5FrameWriter::frame_group(const std::string& dataset) const {
+  if (frame_ < 0)
+    throw std::runtime_error("HDF5 file '" + path_ + "': dataset '" + dataset +
+                             "' written outside begin_frame/end_frame");
+  return frame_;
+}
+
 void Hdf5FrameWriter::write_array(const std::string& name, const double* data,
                                   std::size_t rows, std::size_t cols) {
-  if (frame_ < 0)
-    throw std::runtime_error("HDF5 file '" + path_ + "': dataset '" + name +
-                             "' written outside begin_frame/end_frame");
-  write_dataset(frame_, frame_name_, name, false, data, rows, cols);
+  write_dataset(frame_group(name), frame_name_, name, false, data, rows, cols);
 }
 
 void Hdf5FrameWriter::write_array(const std::string& name, const long long* data,
                                   std::size_t rows, std::size_t cols) {
-  if (frame_ < 0)
-    throw std::runtime_error("HDF5 file '" + path_ + "': dataset '" + name +
-                             "' written outside begin_frame/end_frame");
-  write_dataset(frame_, frame_name_, name, true, data, rows, cols);
+  write_dataset(frame_group(name), frame_name_, name, true, data, rows, cols);
 }
 
 std::int64_t Hdf5FrameWriter::mesh_group() {
@@ -269,10 +273,7 @@ std::vector<long long> read_dataset_int(const std::string& file, const std::stri
 double read_attribute(const std::string& file, const std::string& object,
                       const std::string& name) {
   QuietErrors quiet;
-  Handle fapl(make_fapl(file), H5Pclose);
-  Handle f(check(H5Fopen(file.c_str(), H5F_ACC_RDONLY, fapl.get()), file,
-                 "cannot open for reading"),
-           H5Fclose);
+  Handle f(open_read_only(file), H5Fclose);
   const std::string what = "cannot read attribute '" + name + "' of '" + object + "'";
   Handle attr(check(H5Aopen_by_name(f.get(), object.c_str(), name.c_str(), H5P_DEFAULT,
                                     H5P_DEFAULT),
@@ -289,10 +290,7 @@ double read_attribute(const std::string& file, const std::string& object,
 
 bool dataset_exists(const std::string& file, const std::string& path) {
   QuietErrors quiet;
-  Handle fapl(make_fapl(file), H5Pclose);
-  Handle f(check(H5Fopen(file.c_str(), H5F_ACC_RDONLY, fapl.get()), file,
-                 "cannot open for reading"),
-           H5Fclose);
+  Handle f(open_read_only(file), H5Fclose);
   Handle d(H5Dopen2(f.get(), path.c_str(), H5P_DEFAULT), H5Dclose);
   return d.get() >= 0;
 }

@@ -65,6 +65,7 @@ class Hdf5FrameWriter {
                      bool integer, const void* data, std::size_t rows, std::size_t cols);
   void close_handles() noexcept;
   std::int64_t mesh_group();  // "/mesh", created on first use
+  std::int64_t frame_group(const std::string& dataset) const;  // throws if none open
   void flush(const std::string& after);
 
   std::string path_;

@@ -40,7 +40,7 @@ RunOutput<dim>::RunOutput(const std::string& dir, const Scene& scene, const FemS
   yaml << std::showpoint;
   Teuchos::writeParameterListToYamlOStream(scene.params, yaml);
   write_file_atomically(dir + "/scene.yaml", yaml.str());
-  auto cells = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), sim.mesh().cells);
+  auto cells = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), sim.mesh().elements.nodes);
   std::vector<long long> conn(cells.size());
   for (std::size_t e = 0; e < cells.extent(0); ++e)
     for (int a = 0; a <= dim; ++a) conn[e * (dim + 1) + a] = cells(e, a);

@@ -22,7 +22,9 @@ struct ShapeSpec {
   std::vector<double> size;
   double inner_radius = 0.0;  // ring, half-ring, spherical-shell
   double outer_radius = 0.0;  // disk, ring, half-ring, spherical-shell
-  double element_size = 0.0;  // target edge length (Mesh.MeshSizeMin = Max)
+  // Target edge length (Mesh.MeshSizeMin = Mesh.MeshSizeMax). 2D meshes have
+  // a mean edge of ~1.0 h; Gmsh's 3D Delaunay gives a mean of ~1.15-1.3 h.
+  double element_size = 0.0;
 };
 
 // Meshes `spec` with triangles (dim = 2) or tetrahedra (dim = 3); the result

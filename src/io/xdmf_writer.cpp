@@ -129,7 +129,7 @@ class GridRenderer {
                         std::size_t rows, const std::string& indent) const {
     return indent + "<Attribute Name=\"" + escape(a.name) + "\" AttributeType=\"" +
            attribute_type(a.components) + "\" Center=\"" + center + "\">\n" +
-           data_item(g, a.dataset, rows, a.components, false, indent + "  ") + indent +
+           data_item(g, a.dataset, rows, a.components, a.integer, indent + "  ") + indent +
            "</Attribute>\n";
   }
 

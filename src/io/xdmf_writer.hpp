@@ -30,6 +30,7 @@ struct XdmfAttribute {
   std::string dataset;
   // 1 -> Scalar, 2 or 3 -> Vector, 6 -> Tensor6, 9 -> Tensor, other -> Matrix.
   int components = 1;
+  bool integer = false;  // int64 dataset (default: float64)
 };
 
 struct XdmfGrid {

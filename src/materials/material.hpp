@@ -18,7 +18,7 @@ struct MaterialParams {
 };
 
 // "neo_hookean" / "linear_elastic".
-inline const char* material_model_name(MaterialModel m) {
+KOKKOS_INLINE_FUNCTION const char* material_model_name(MaterialModel m) {
   switch (m) {
     case MaterialModel::NeoHookean: return "neo_hookean";
     case MaterialModel::LinearElastic: return "linear_elastic";

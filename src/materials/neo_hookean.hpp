@@ -41,7 +41,9 @@ struct NeoHookean {
       for (int i = 0; i < dim; ++i)
         for (int l = 0; l < dim; ++l)
           for (int k = 0; k < dim; ++k) {
-            double v = a * Finv(l, i) * Finv(j, k) + p.lambda * Finv(j, i) * Finv(l, k);
+            // Products grouped so that entry (ij, kl) and (kl, ij) round
+            // identically: the matrix is exactly symmetric.
+            double v = a * (Finv(l, i) * Finv(j, k)) + p.lambda * (Finv(j, i) * Finv(l, k));
             if (i == k && j == l) v += p.mu;
             dPdF(i + dim * j, k + dim * l) = v;
           }

@@ -3,7 +3,6 @@
 #include <Kokkos_Timer.hpp>
 #include <sstream>
 
-#include "kernels/fem_elasticity.hpp"
 #include "solver/solver_error.hpp"
 
 namespace bfemp {
@@ -15,7 +14,9 @@ FemSimulation<dim>::FemSimulation(FemSetup<dim> setup, const Teuchos::RCP<const 
     : setup_(std::move(setup)), mesh_(build_fem_mesh<dim>(setup_.bodies, setup_.materials)) {
   if (!(setup_.dt > 0))
     throw std::invalid_argument("time step dt = " + std::to_string(setup_.dt) + ": expected dt > 0");
-  newton_ = std::make_unique<NewtonSolver<dim>>(mesh_, comm, setup_.linear_solver, setup_.newton);
+  elasticity_ = std::make_unique<DeformationTerm<dim, dim + 1>>("fem elasticity", mesh_.elements);
+  newton_ = std::make_unique<NewtonSolver<dim>>(comm, setup_.linear_solver, setup_.newton);
+  newton_->set_system(mesh_.num_nodes(), {elasticity_.get()}, true);
   const std::size_t n = static_cast<std::size_t>(mesh_.num_nodes()) * dim;
   x_ = View1("fem_x", n);
   v_ = View1("fem_v", n);
@@ -69,7 +70,7 @@ void FemSimulation<dim>::reset_acceleration() {
   auto m = mass_;
   auto pres = prescribed_;
   Kokkos::deep_copy(a, 0.0);
-  fem_elastic_gradient<dim>(mesh_, x_, -1.0, a);
+  newton_->potential_gradient(x_, -1.0, a);
   const auto g = setup_.gravity;
   Kokkos::parallel_for(
       "fem_a0", Kokkos::RangePolicy<ExecSpace>(0, a.extent(0)), KOKKOS_LAMBDA(const LO i) {
@@ -182,25 +183,20 @@ StepReport FemSimulation<dim>::diagnostics() const {
   r.kinetic = ke;
   r.potential = pe;
   r.momentum = {p0, p1, p2};
-  r.elastic = fem_elastic_energy<dim>(mesh_, x_);
-  View1 J("fem_J_tmp", mesh_.num_cells());
-  element_J(J);
-  double jmin = 0;
-  Kokkos::parallel_reduce(
-      "fem_min_J", Kokkos::RangePolicy<ExecSpace>(0, J.extent(0)),
-      KOKKOS_LAMBDA(const LO e, double& acc) { acc = std::fmin(acc, J(e)); }, Kokkos::Min<double>(jmin));
-  r.min_J = jmin;
+  r.elastic = newton_->potential(x_);
+  r.min_J = deformation_min_J(mesh_.elements, x_);
   return r;
 }
 
 template <int dim>
 void FemSimulation<dim>::element_J(View1 J) const {
-  fem_element_J<dim>(mesh_, x_, J);
+  deformation_J_von_mises(mesh_.elements, x_, J, View1());
 }
 
 template <int dim>
 void FemSimulation<dim>::element_von_mises(View1 s) const {
-  fem_element_von_mises<dim>(mesh_, x_, s);
+  View1 J("fem_J_tmp", mesh_.num_cells());
+  deformation_J_von_mises(mesh_.elements, x_, J, s);
 }
 
 template class FemSimulation<2>;

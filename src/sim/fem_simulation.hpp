@@ -65,6 +65,7 @@ class FemSimulation {
 
   FemSetup<dim> setup_;
   FemMesh<dim> mesh_;
+  std::unique_ptr<DeformationTerm<dim, dim + 1>> elasticity_;
   std::unique_ptr<NewtonSolver<dim>> newton_;
   Kokkos::View<double*, MemSpace> x_, v_, a_, x_hat_, target_, mass_, initial_position_;
   Kokkos::View<int*, MemSpace> prescribed_;

@@ -7,18 +7,8 @@
 namespace bfemp {
 
 template <int dim>
-Teuchos::RCP<const Graph> build_dof_graph(const FemMesh<dim>& mesh,
+Teuchos::RCP<const Graph> build_dof_graph(std::vector<long long>& keys, LO n_nodes,
                                           const Teuchos::RCP<const Map>& dof_map) {
-  constexpr int nv = dim + 1;
-  const LO n_nodes = mesh.num_nodes();
-  auto cells = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), mesh.cells);
-  // Node adjacency as sorted (a, b) pairs, including a == b.
-  std::vector<long long> keys;
-  keys.reserve(static_cast<std::size_t>(mesh.num_cells()) * nv * nv + n_nodes);
-  for (LO e = 0; e < mesh.num_cells(); ++e)
-    for (int a = 0; a < nv; ++a)
-      for (int b = 0; b < nv; ++b)
-        keys.push_back(static_cast<long long>(cells(e, a)) * n_nodes + cells(e, b));
   for (LO i = 0; i < n_nodes; ++i) keys.push_back(static_cast<long long>(i) * n_nodes + i);
   std::sort(keys.begin(), keys.end());
   keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
@@ -49,7 +39,7 @@ Teuchos::RCP<const Graph> build_dof_graph(const FemMesh<dim>& mesh,
   return graph;
 }
 
-template Teuchos::RCP<const Graph> build_dof_graph<2>(const FemMesh<2>&, const Teuchos::RCP<const Map>&);
-template Teuchos::RCP<const Graph> build_dof_graph<3>(const FemMesh<3>&, const Teuchos::RCP<const Map>&);
+template Teuchos::RCP<const Graph> build_dof_graph<2>(std::vector<long long>&, LO, const Teuchos::RCP<const Map>&);
+template Teuchos::RCP<const Graph> build_dof_graph<3>(std::vector<long long>&, LO, const Teuchos::RCP<const Map>&);
 
 }  // namespace bfemp

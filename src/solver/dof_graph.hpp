@@ -1,16 +1,18 @@
 #pragma once
-// Sparsity of the node-interleaved DOF system: every DOF couples with every
-// DOF of the nodes it shares an element with. Built once per mesh.
+// Sparsity of the node-interleaved DOF system from node couplings: DOF
+// (a, c) couples with every DOF of node b for each coupled node pair (a, b).
 #include <Teuchos_RCP.hpp>
+#include <vector>
 
-#include "fem/fem_mesh.hpp"
 #include "solver/tpetra_types.hpp"
 
 namespace bfemp {
 
-// Graph on `dof_map` (1 rank: column map == row map, local ids == DOF ids).
+// `keys` holds a * n_nodes + b for coupled nodes (any order, duplicates
+// allowed; consumed: sorted and deduplicated in place). Every node couples
+// with itself. 1 rank: column map == row map, local ids == DOF ids.
 template <int dim>
-Teuchos::RCP<const Graph> build_dof_graph(const FemMesh<dim>& mesh,
+Teuchos::RCP<const Graph> build_dof_graph(std::vector<long long>& keys, LO n_nodes,
                                           const Teuchos::RCP<const Map>& dof_map);
 
 }  // namespace bfemp

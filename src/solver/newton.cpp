@@ -7,7 +7,6 @@
 #include <limits>
 #include <sstream>
 
-#include "kernels/fem_elasticity.hpp"
 #include "solver/dof_graph.hpp"
 #include "solver/solver_error.hpp"
 
@@ -18,38 +17,48 @@ using CView1 = Kokkos::View<const double*, MemSpace>;
 
 template <int dim>
 struct NewtonSolver<dim>::Impl {
-  const FemMesh<dim>& mesh;
+  Teuchos::RCP<const Comm> comm;
   NewtonParams params;
+  LinearSolver solver;
+  std::vector<const EnergyTerm<dim>*> terms;
+  LO n_nodes = -1;
   Teuchos::RCP<const Map> map;
   Teuchos::RCP<Matrix> A;
-  Vector b, p;
-  LinearSolver solver;
+  Teuchos::RCP<Vector> b, p;
   View1 grad, rhs, dx_prescribed, dir, trial;
   Teuchos::RCP<Teuchos::ParameterList> fill_params;
+  double graph_build_s = 0;
 
-  Impl(const FemMesh<dim>& m, const Teuchos::RCP<const Comm>& comm,
-       const Teuchos::ParameterList& ls, NewtonParams np)
-      : mesh(m),
-        params(np),
-        map(Teuchos::rcp(new Map(static_cast<Tpetra::global_size_t>(m.num_nodes()) * dim, 0, comm))),
-        A(Teuchos::rcp(new Matrix(build_dof_graph<dim>(m, map)))),
-        b(map),
-        p(map),
-        solver(ls, comm) {
+  Impl(const Teuchos::RCP<const Comm>& c, const Teuchos::ParameterList& ls, NewtonParams np)
+      : comm(c), params(np), solver(ls, c) {
     if (comm->getSize() > 1)
       throw std::invalid_argument(
           "the Newton solver runs on 1 MPI rank in this version (the distributed "
           "assembly comes with the MPI issue); run without mpirun or with -np 1");
-    A->fillComplete();
-    solver.set_matrix(A);
-    const std::size_t n = static_cast<std::size_t>(m.num_nodes()) * dim;
-    grad = View1("newton_grad", n);
-    rhs = View1("newton_rhs", n);
-    dx_prescribed = View1("newton_dx_prescribed", n);
-    dir = View1("newton_dir", n);
-    trial = View1("newton_trial", n);
     fill_params = Teuchos::parameterList();
     fill_params->set("No Nonlocal Changes", true);
+  }
+
+  void rebuild(LO n) {
+    Kokkos::Timer timer;
+    const std::size_t ndof = static_cast<std::size_t>(n) * dim;
+    if (n != n_nodes) {
+      map = Teuchos::rcp(new Map(static_cast<Tpetra::global_size_t>(ndof), 0, comm));
+      b = Teuchos::rcp(new Vector(map));
+      p = Teuchos::rcp(new Vector(map));
+      grad = View1("newton_grad", ndof);
+      rhs = View1("newton_rhs", ndof);
+      dx_prescribed = View1("newton_dx_prescribed", ndof);
+      dir = View1("newton_dir", ndof);
+      trial = View1("newton_trial", ndof);
+      n_nodes = n;
+    }
+    std::vector<long long> keys;
+    for (const auto* t : terms) t->add_couplings(keys, n);
+    A = Teuchos::rcp(new Matrix(build_dof_graph<dim>(keys, n, map)));
+    A->fillComplete();
+    solver.set_matrix(A);
+    graph_build_s = timer.seconds();
   }
 
   // Gradient, projected Hessian and right-hand side at x.
@@ -62,7 +71,7 @@ struct NewtonSolver<dim>::Impl {
     A->resumeFill();
     A->setAllToScalar(0.0);
     auto lcl = A->getLocalMatrixDevice();
-    fem_elastic_assemble<dim>(mesh, x, ip.h, g, lcl, ip.prescribed, dxp, r);
+    for (const auto* t : terms) t->assemble(x, ip.h, g, lcl, ip.prescribed, dxp, r);
     auto mass = ip.mass;
     auto xhat = ip.x_hat;
     auto pres = ip.prescribed;
@@ -83,17 +92,19 @@ struct NewtonSolver<dim>::Impl {
 };
 
 template <int dim>
-double NewtonSolver<dim>::Energy::total() const {
-  return inertia + elastic;
-}
-
-template <int dim>
-NewtonSolver<dim>::NewtonSolver(const FemMesh<dim>& mesh, const Teuchos::RCP<const Comm>& comm,
-                                const Teuchos::ParameterList& ls, NewtonParams params)
-    : impl_(new Impl(mesh, comm, ls, params)) {}
+NewtonSolver<dim>::NewtonSolver(const Teuchos::RCP<const Comm>& comm, const Teuchos::ParameterList& ls,
+                                NewtonParams params)
+    : impl_(new Impl(comm, ls, params)) {}
 
 template <int dim>
 NewtonSolver<dim>::~NewtonSolver() = default;
+
+template <int dim>
+void NewtonSolver<dim>::set_system(LO n_nodes, std::vector<const EnergyTerm<dim>*> terms,
+                                   bool structure_changed) {
+  impl_->terms = std::move(terms);
+  if (structure_changed || n_nodes != impl_->n_nodes || impl_->A.is_null()) impl_->rebuild(n_nodes);
+}
 
 template <int dim>
 const LinearSolver& NewtonSolver<dim>::linear_solver() const {
@@ -103,6 +114,23 @@ const LinearSolver& NewtonSolver<dim>::linear_solver() const {
 template <int dim>
 Teuchos::RCP<const Map> NewtonSolver<dim>::dof_map() const {
   return impl_->map;
+}
+
+template <int dim>
+double NewtonSolver<dim>::last_graph_build_s() const {
+  return impl_->graph_build_s;
+}
+
+template <int dim>
+double NewtonSolver<dim>::potential(CView1 x) const {
+  double e = 0;
+  for (const auto* t : impl_->terms) e += t->energy(x);
+  return e;
+}
+
+template <int dim>
+void NewtonSolver<dim>::potential_gradient(CView1 x, double scale, View1 grad) const {
+  for (const auto* t : impl_->terms) t->gradient(x, scale, grad);
 }
 
 template <int dim>
@@ -118,7 +146,7 @@ typename NewtonSolver<dim>::Energy NewtonSolver<dim>::energy(const IncrementalPo
         acc += 0.5 * mass(i) * d * d;
       },
       E.inertia);
-  E.elastic = ip.h * fem_elastic_energy<dim>(impl_->mesh, x);
+  E.elastic = ip.h * potential(x);
   return E;
 }
 
@@ -150,14 +178,14 @@ NewtonStats NewtonSolver<dim>::minimize(const IncrementalPotential& ip, View1 x)
 
     timer.reset();
     {
-      auto bv = Kokkos::subview(m.b.getLocalViewDevice(Tpetra::Access::OverwriteAll), Kokkos::ALL(), 0);
+      auto bv = Kokkos::subview(m.b->getLocalViewDevice(Tpetra::Access::OverwriteAll), Kokkos::ALL(), 0);
       Kokkos::deep_copy(bv, m.rhs);
     }
-    m.p.putScalar(0.0);
-    const LinearSolveStats ls = m.solver.solve(m.b, m.p);
+    m.p->putScalar(0.0);
+    const LinearSolveStats ls = m.solver.solve(*m.b, *m.p);
     st.linear_iterations += ls.iterations;
     {
-      auto pv = Kokkos::subview(m.p.getLocalViewDevice(Tpetra::Access::ReadOnly), Kokkos::ALL(), 0);
+      auto pv = Kokkos::subview(m.p->getLocalViewDevice(Tpetra::Access::ReadOnly), Kokkos::ALL(), 0);
       Kokkos::deep_copy(dir, pv);
     }
     st.solve_s += timer.seconds();
@@ -174,7 +202,8 @@ NewtonStats NewtonSolver<dim>::minimize(const IncrementalPotential& ip, View1 x)
     if (!std::isfinite(p_inf))
       throw SolverError("Newton direction is not finite (linear solve produced NaN/Inf)");
 
-    const double a_max = fem_max_feasible_step<dim>(m.mesh, x, dir);
+    double a_max = std::numeric_limits<double>::infinity();
+    for (const auto* t : m.terms) a_max = std::min(a_max, t->max_step(x, dir));
     double alpha = std::min(1.0, 0.9 * a_max);
     const bool converged = p_inf / ip.dt < m.params.eps_d && pres_left == 0.0;
     // Armijo-type backtracking on E while the prescribed DOFs are at their

@@ -6,11 +6,13 @@
 // det F > 0) followed by backtracking, and the stop test |p|_inf / dt < eps_d.
 // Prescribed DOFs are driven toward their targets inside the same iterations:
 // their part of p is the remaining offset, so the filter also guards them.
+// Psi is a sum of EnergyTerms (FEM elements, MPM particles, ...); the system
+// graph is rebuilt only when set_system() says the structure changed.
 #include <Teuchos_ParameterList.hpp>
 #include <functional>
 #include <memory>
 
-#include "fem/fem_mesh.hpp"
+#include "solver/energy_term.hpp"
 #include "solver/linear_solver.hpp"
 #include "solver/tpetra_types.hpp"
 
@@ -41,9 +43,15 @@ struct IncrementalPotential {
 template <int dim>
 class NewtonSolver {
  public:
-  NewtonSolver(const FemMesh<dim>& mesh, const Teuchos::RCP<const Comm>& comm,
-               const Teuchos::ParameterList& linear_solver, NewtonParams params);
+  NewtonSolver(const Teuchos::RCP<const Comm>& comm, const Teuchos::ParameterList& linear_solver,
+               NewtonParams params);
   ~NewtonSolver();
+
+  // Declares the unknowns (n_nodes * dim DOFs) and the terms of Psi. With
+  // `structure_changed` (or a new node count) the map, graph and matrix are
+  // rebuilt and the linear solver redoes its symbolic phase; otherwise the
+  // existing graph is reused. The terms must outlive the next minimize().
+  void set_system(LO n_nodes, std::vector<const EnergyTerm<dim>*> terms, bool structure_changed);
 
   // Minimises E from the initial guess in `x` (overwritten with the result).
   // Throws SolverError when the linear solve fails, the line search stalls or
@@ -51,14 +59,19 @@ class NewtonSolver {
   NewtonStats minimize(const IncrementalPotential& ip, Kokkos::View<double*, MemSpace> x);
 
   // Energy E(x) and its parts; exposed for tests and diagnostics.
-  struct Energy { double inertia = 0, elastic = 0; double total() const; };
+  struct Energy { double inertia = 0, elastic = 0; double total() const { return inertia + elastic; } };
   Energy energy(const IncrementalPotential& ip, Kokkos::View<const double*, MemSpace> x) const;
+  // Psi(x) (unscaled) and grad += scale * dPsi/dx over all terms.
+  double potential(Kokkos::View<const double*, MemSpace> x) const;
+  void potential_gradient(Kokkos::View<const double*, MemSpace> x, double scale,
+                          Kokkos::View<double*, MemSpace> grad) const;
 
   // Called after every accepted Newton iterate (debug checks, tests).
   std::function<void(Kokkos::View<const double*, MemSpace>)> on_iterate;
 
   const LinearSolver& linear_solver() const;
   Teuchos::RCP<const Map> dof_map() const;
+  double last_graph_build_s() const;
 
  private:
   struct Impl;

@@ -174,7 +174,7 @@ XdmfGrid fem_grid(int f, bool two_d) {
   g.topology = {"Triangle", 2, 3, "/mesh/cells"};
   g.num_nodes = 4;
   g.dim = two_d ? 2 : 3;
-  g.node_attributes = {{"velocity", "velocity", 2}, {"ids", "ids", 1}};
+  g.node_attributes = {{"velocity", "velocity", 2}, {"ids", "ids", 1, true}};
   g.cell_attributes = {{"pressure", "pressure", 1}};
   return g;
 }
@@ -214,6 +214,7 @@ TEST(XdmfSeries, RewrittenAfterEachFrame) {
       EXPECT_EQ(count(xml, t.str()), 1u) << t.str();
     }
     EXPECT_NE(xml.find("AttributeType=\"Vector\" Center=\"Node\""), std::string::npos);
+    EXPECT_EQ(count(xml, "NumberType=\"Int\""), 2u * (f + 1));  // cells and ids
     EXPECT_NE(xml.find("Name=\"pressure\" AttributeType=\"Scalar\" Center=\"Cell\""),
               std::string::npos);
     // topology + geometry + 3 attributes per frame

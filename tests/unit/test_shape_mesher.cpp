@@ -67,12 +67,16 @@ EdgeStats edge_stats(const MeshData& m) {
   return s;
 }
 
-// The element size is honoured roughly: mean edge within 25 %, no edge > 2.5 h.
+// The element size is honoured roughly. 2D: mean edge within 15 % of h, no
+// edge > 2 h. 3D: Gmsh's Delaunay refinement leaves interior edges of up to
+// ~1.4 h (measured mean 1.15-1.3 h for boxes and shells), so the mean must lie
+// in [0.9 h, 1.4 h] and no edge may exceed 2.5 h.
 void expect_size_honoured(const MeshData& m, double h) {
   const EdgeStats s = edge_stats(m);
-  EXPECT_GT(s.mean, 0.75 * h);
-  EXPECT_LT(s.mean, 1.25 * h);
-  EXPECT_LT(s.max, 2.5 * h);
+  const bool two_d = m.dim == 2;
+  EXPECT_GT(s.mean, (two_d ? 0.85 : 0.9) * h);
+  EXPECT_LT(s.mean, (two_d ? 1.15 : 1.4) * h);
+  EXPECT_LT(s.max, (two_d ? 2.0 : 2.5) * h);
 }
 
 std::string error_of(const ShapeSpec& s, int dim) {

@@ -1,0 +1,181 @@
+#pragma once
+// Kokkos kernels of an elastic energy Psi(x) = sum_q V_q psi(F_q(x)) whose
+// deformation gradients are linear in nodal positions over a stencil:
+//   F_q(x) = sum_a x_{n(q,a)} g_{qa}^T.
+// FEM simplices: g_qa = grad N_a (rest shape-function gradients, nv = dim+1).
+// MPM particles:  g_qa = F_q^n^T grad w_{aq} (B-spline stencil, nv = 3^dim).
+// Value, gradient, PSD-projected Hessian (V B^T (dP/dF)_+ B, never an
+// eigen-decomposition of the stencil matrix), det F > 0 step bound, J and von
+// Mises. Positions and directions are node-interleaved (node*dim + c).
+#include <Kokkos_Core.hpp>
+#include <cmath>
+
+#include "core/types.hpp"
+#include "fem/det_root.hpp"
+#include "materials/material.hpp"
+
+namespace bfemp {
+
+template <int dim, int nv>
+struct DeformationStencils {
+  Kokkos::View<LO* [nv], MemSpace> nodes;       // system node ids
+  Kokkos::View<double* [nv][dim], MemSpace> g;  // F = sum_a x_a g_a^T
+  Kokkos::View<double*, MemSpace> volume;       // rest volume V_q
+  Kokkos::View<int*, MemSpace> material;        // index into materials
+  Kokkos::View<MaterialParams*, MemSpace> materials;
+  LO size() const { return static_cast<LO>(nodes.extent(0)); }
+};
+
+template <int dim, int nv, class XView>
+KOKKOS_INLINE_FUNCTION Mat<dim> stencil_F(const DeformationStencils<dim, nv>& s, const XView& x, LO q) {
+  Mat<dim> F = Mat<dim>::Zero();
+  for (int a = 0; a < nv; ++a) {
+    const LO n = s.nodes(q, a);
+    for (int i = 0; i < dim; ++i)
+      for (int j = 0; j < dim; ++j) F(i, j) += x(n * dim + i) * s.g(q, a, j);
+  }
+  return F;
+}
+
+template <int dim, int nv>
+double deformation_energy(const DeformationStencils<dim, nv>& s, Kokkos::View<const double*, MemSpace> x) {
+  double total = 0;
+  Kokkos::parallel_reduce(
+      "deformation_energy", Kokkos::RangePolicy<ExecSpace>(0, s.size()),
+      KOKKOS_LAMBDA(const LO q, double& acc) {
+        acc += s.volume(q) * material_energy<dim>(s.materials(s.material(q)), stencil_F(s, x, q));
+      },
+      total);
+  return total;
+}
+
+// grad += scale * dPsi/dx.
+template <int dim, int nv>
+void deformation_gradient(const DeformationStencils<dim, nv>& s, Kokkos::View<const double*, MemSpace> x,
+                          double scale, Kokkos::View<double*, MemSpace> grad) {
+  Kokkos::parallel_for(
+      "deformation_gradient", Kokkos::RangePolicy<ExecSpace>(0, s.size()), KOKKOS_LAMBDA(const LO q) {
+        const Mat<dim> P = material_first_piola<dim>(s.materials(s.material(q)), stencil_F(s, x, q));
+        const double w = scale * s.volume(q);
+        for (int a = 0; a < nv; ++a)
+          for (int k = 0; k < dim; ++k) {
+            double v = 0;
+            for (int j = 0; j < dim; ++j) v += P(k, j) * s.g(q, a, j);
+            Kokkos::atomic_add(&grad(s.nodes(q, a) * dim + k), w * v);
+          }
+      });
+}
+
+// grad += scale * dPsi/dx and the Hessian blocks scale * V B^T (dP/dF)_+ B
+// summed into the rows of free DOFs of `A` (local column ids == DOF ids).
+// Couplings to prescribed DOFs move to the right-hand side:
+// rhs(free) -= H(free, prescribed) * dx_prescribed(prescribed).
+template <int dim, int nv, class LocalMatrix>
+void deformation_assemble(const DeformationStencils<dim, nv>& s, Kokkos::View<const double*, MemSpace> x,
+                          double scale, Kokkos::View<double*, MemSpace> grad, const LocalMatrix& A,
+                          Kokkos::View<const int*, MemSpace> prescribed,
+                          Kokkos::View<const double*, MemSpace> dx_prescribed,
+                          Kokkos::View<double*, MemSpace> rhs) {
+  constexpr int nd = nv * dim;
+  constexpr int dd = dim * dim;
+  Kokkos::parallel_for(
+      "deformation_assemble", Kokkos::RangePolicy<ExecSpace>(0, s.size()), KOKKOS_LAMBDA(const LO q) {
+        const MaterialParams& mp = s.materials(s.material(q));
+        const Mat<dim> F = stencil_F(s, x, q);
+        const double w = scale * s.volume(q);
+        const Mat<dim> P = material_first_piola<dim>(mp, F);
+        const StressDerivative<dim> D = material_stress_derivative_psd<dim>(mp, F);
+        LO dof[nd];
+        for (int a = 0; a < nv; ++a)
+          for (int k = 0; k < dim; ++k) dof[a * dim + k] = s.nodes(q, a) * dim + k;
+        for (int a = 0; a < nv; ++a)
+          for (int k = 0; k < dim; ++k) {
+            double v = 0;
+            for (int j = 0; j < dim; ++j) v += P(k, j) * s.g(q, a, j);
+            Kokkos::atomic_add(&grad(dof[a * dim + k]), w * v);
+          }
+        // DB(:, b*dim + l) = sum_m D(:, l + dim m) g(b, m) = (dP/dF) dvec(F)/dx_{b,l}
+        Eigen::Matrix<double, dd, nd> DB;
+        for (int b = 0; b < nv; ++b)
+          for (int l = 0; l < dim; ++l) {
+            Eigen::Matrix<double, dd, 1> col = Eigen::Matrix<double, dd, 1>::Zero();
+            for (int m = 0; m < dim; ++m) col += D.col(l + dim * m) * s.g(q, b, m);
+            DB.col(b * dim + l) = col;
+          }
+        LO cols[nd];
+        double vals[nd];
+        for (int a = 0; a < nv; ++a)
+          for (int k = 0; k < dim; ++k) {
+            const int r = a * dim + k;
+            if (prescribed(dof[r])) continue;
+            int nc = 0;
+            double rhs_r = 0;
+            for (int c = 0; c < nd; ++c) {
+              double h = 0;
+              for (int j = 0; j < dim; ++j) h += DB(k + dim * j, c) * s.g(q, a, j);
+              h *= w;
+              if (prescribed(dof[c])) {
+                rhs_r -= h * dx_prescribed(dof[c]);
+              } else {
+                cols[nc] = dof[c];
+                vals[nc] = h;
+                ++nc;
+              }
+            }
+            A.sumIntoValues(dof[r], cols, nc, vals, false, true);
+            if (rhs_r != 0) Kokkos::atomic_add(&rhs(dof[r]), rhs_r);
+          }
+      });
+}
+
+// Largest alpha in (0, inf] such that det F_q(x + t p) > 0 for all t < alpha.
+template <int dim, int nv>
+double deformation_max_step(const DeformationStencils<dim, nv>& s, Kokkos::View<const double*, MemSpace> x,
+                            Kokkos::View<const double*, MemSpace> p) {
+  double amin = 0;
+  Kokkos::parallel_reduce(
+      "deformation_max_step", Kokkos::RangePolicy<ExecSpace>(0, s.size()),
+      KOKKOS_LAMBDA(const LO q, double& acc) {
+        const double a = smallest_positive_det_root<dim>(stencil_F(s, x, q), stencil_F(s, p, q));
+        if (a < acc) acc = a;
+      },
+      Kokkos::Min<double>(amin));
+  return amin;
+}
+
+// J = det F_q and the von Mises stress of sigma = P F^T / J (2D: in-plane
+// components, sqrt(sxx^2 - sxx syy + syy^2 + 3 sxy^2)).
+template <int dim, int nv>
+void deformation_J_von_mises(const DeformationStencils<dim, nv>& s, Kokkos::View<const double*, MemSpace> x,
+                             Kokkos::View<double*, MemSpace> J, Kokkos::View<double*, MemSpace> von_mises) {
+  Kokkos::parallel_for(
+      "deformation_J_von_mises", Kokkos::RangePolicy<ExecSpace>(0, s.size()), KOKKOS_LAMBDA(const LO q) {
+        const Mat<dim> F = stencil_F(s, x, q);
+        const double det = F.determinant();
+        J(q) = det;
+        if (von_mises.extent(0) == 0) return;
+        const Mat<dim> sg = material_first_piola<dim>(s.materials(s.material(q)), F) * F.transpose() / det;
+        if constexpr (dim == 2) {
+          von_mises(q) = std::sqrt(sg(0, 0) * sg(0, 0) - sg(0, 0) * sg(1, 1) + sg(1, 1) * sg(1, 1) +
+                                   3 * sg(0, 1) * sg(0, 1));
+        } else {
+          const Mat<dim> dev = sg - sg.trace() / 3.0 * Mat<dim>::Identity();
+          von_mises(q) = std::sqrt(1.5 * dev.squaredNorm());
+        }
+      });
+}
+
+template <int dim, int nv>
+double deformation_min_J(const DeformationStencils<dim, nv>& s, Kokkos::View<const double*, MemSpace> x) {
+  double jmin = 0;
+  Kokkos::parallel_reduce(
+      "deformation_min_J", Kokkos::RangePolicy<ExecSpace>(0, s.size()),
+      KOKKOS_LAMBDA(const LO q, double& acc) {
+        const double j = stencil_F(s, x, q).determinant();
+        if (j < acc) acc = j;
+      },
+      Kokkos::Min<double>(jmin));
+  return jmin;
+}
+
+}  // namespace bfemp

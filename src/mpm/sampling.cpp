@@ -1,0 +1,296 @@
+#include "mpm/sampling.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <stdexcept>
+
+namespace bfemp {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+constexpr double kMaxCandidates = 1e8;
+
+std::string fmt(double v) {
+  char s[32];
+  std::snprintf(s, sizeof s, "%.10g", v);
+  return s;
+}
+
+[[noreturn]] void bad(const std::string& field, const std::string& value, const std::string& expected) {
+  throw std::invalid_argument("sampling field '" + field + "' = " + value + ": expected " + expected);
+}
+
+void require_positive(const std::string& field, double v) {
+  if (!(v > 0.0) || !std::isfinite(v)) bad(field, fmt(v), "a finite value > 0");
+}
+
+// Dimension of a kind: 2, 3, or 0 for kinds available in both.
+int kind_dim(const std::string& kind) {
+  if (kind == "rectangle" || kind == "disk" || kind == "ring" || kind == "half-ring") return 2;
+  if (kind == "sphere") return 3;
+  if (kind == "box" || kind == "mesh" || kind == "sdf") return 0;
+  bad("kind", "'" + kind + "'", "one of box, rectangle, disk, sphere, ring, half-ring, mesh, sdf");
+}
+
+bool is_box(const std::string& kind) { return kind == "box" || kind == "rectangle"; }
+
+// Checks every field the kind uses (and only those).
+void validate_shape(const SamplingShape& s, int dim) {
+  if (dim != 2 && dim != 3) bad("dim", std::to_string(dim), "2 or 3");
+  const int kd = kind_dim(s.kind);
+  if (kd != 0 && kd != dim)
+    bad("kind", "'" + s.kind + "'",
+        "a " + std::to_string(dim) + "D shape (it is " + std::to_string(kd) + "D)");
+  if (!s.center.empty() && s.center.size() != static_cast<std::size_t>(dim))
+    bad("center", std::to_string(s.center.size()) + " entries", std::to_string(dim) + " entries");
+  for (double c : s.center)
+    if (!std::isfinite(c)) bad("center", fmt(c), "finite coordinates");
+  if (is_box(s.kind) || s.kind == "sdf") {
+    if (s.size.size() != static_cast<std::size_t>(dim))
+      bad("size", std::to_string(s.size.size()) + " entries", std::to_string(dim) + " entries");
+    for (std::size_t i = 0; i < s.size.size(); ++i) require_positive("size[" + std::to_string(i) + "]", s.size[i]);
+    if (s.kind == "sdf" && !s.sdf) bad("sdf", "empty", "a signed-distance function");
+  } else if (s.kind == "mesh") {
+    if (s.mesh == nullptr) bad("mesh", "null", "a mesh");
+    if (s.mesh->dim != dim) bad("mesh", "of dimension " + std::to_string(s.mesh->dim), std::to_string(dim) + "D");
+    if (s.mesh->num_cells() == 0) bad("mesh", "without cells", "at least one cell");
+  } else {
+    require_positive("outer_radius", s.outer_radius);
+    if (s.kind == "ring" || s.kind == "half-ring") {
+      require_positive("inner_radius", s.inner_radius);
+      if (s.inner_radius >= s.outer_radius)
+        bad("inner_radius", fmt(s.inner_radius), "< outer_radius = " + fmt(s.outer_radius));
+    }
+  }
+}
+
+template <int dim>
+Vec<dim> center_of(const SamplingShape& s) {
+  Vec<dim> c = Vec<dim>::Zero();
+  for (std::size_t d = 0; d < s.center.size(); ++d) c[d] = s.center[d];
+  return c;
+}
+
+// Axis-aligned box [lo, hi] holding the whole shape.
+template <int dim>
+void bounding_box(const SamplingShape& s, Vec<dim>& lo, Vec<dim>& hi) {
+  const Vec<dim> c = center_of<dim>(s);
+  if (is_box(s.kind) || s.kind == "sdf") {
+    for (int d = 0; d < dim; ++d) {
+      lo[d] = c[d] - 0.5 * s.size[d];
+      hi[d] = c[d] + 0.5 * s.size[d];
+    }
+  } else if (s.kind == "mesh") {
+    lo.setConstant(std::numeric_limits<double>::infinity());
+    hi = -lo;
+    const MeshData& m = *s.mesh;
+    for (std::size_t n = 0; n < m.num_nodes(); ++n)
+      for (int d = 0; d < dim; ++d) {
+        lo[d] = std::min(lo[d], m.coords[n * dim + d]);
+        hi[d] = std::max(hi[d], m.coords[n * dim + d]);
+      }
+  } else {
+    lo = (c.array() - s.outer_radius).matrix();
+    hi = (c.array() + s.outer_radius).matrix();
+    if (s.kind == "half-ring") lo[1] = c[1];
+  }
+}
+
+// Negative strictly inside an analytic or sdf shape.
+template <int dim>
+double inside_function(const SamplingShape& s, const Vec<dim>& c, const Vec<dim>& x) {
+  if (is_box(s.kind)) return ((x - c).cwiseAbs() - 0.5 * Vec<dim>(s.size.data())).maxCoeff();
+  if (s.kind == "sdf") return s.sdf(x.data());
+  const double r = (x - c).norm();
+  if (s.kind == "disk" || s.kind == "sphere") return r - s.outer_radius;
+  const double ring = std::max(r - s.outer_radius, s.inner_radius - r);
+  return s.kind == "ring" ? ring : std::max(ring, c[1] - x[1]);
+}
+
+// Candidate lattice: points m in [m_lo, m_lo + count) per axis, point
+// coordinate (m + 1/2) h, linear index with x fastest.
+template <int dim>
+struct Lattice {
+  long long m_lo[dim], count[dim];
+  double h;
+  std::size_t size() const {
+    std::size_t n = 1;
+    for (int d = 0; d < dim; ++d) n *= static_cast<std::size_t>(count[d]);
+    return n;
+  }
+  Vec<dim> point(const long long* m) const {
+    Vec<dim> x;
+    for (int d = 0; d < dim; ++d) x[d] = (static_cast<double>(m[d]) + 0.5) * h;
+    return x;
+  }
+  std::size_t linear(const long long* m) const {
+    std::size_t n = 0;
+    for (int d = dim - 1; d >= 0; --d) n = n * count[d] + static_cast<std::size_t>(m[d] - m_lo[d]);
+    return n;
+  }
+};
+
+// Calls f(m) for every m with lo <= m <= hi (inclusive, x fastest).
+template <int dim, class Fn>
+void for_each_point(const long long* lo, const long long* hi, Fn&& f) {
+  for (int d = 0; d < dim; ++d)
+    if (hi[d] < lo[d]) return;
+  long long m[dim];
+  std::copy(lo, lo + dim, m);
+  for (;;) {
+    f(static_cast<const long long*>(m));
+    int d = 0;
+    for (; d < dim && m[d] == hi[d]; ++d) m[d] = lo[d];  // carry into the next axis
+    if (d == dim) return;
+    ++m[d];
+  }
+}
+
+// Lattice points inside the cells of the mesh (barycentric test with a
+// rounding tolerance, so points on shared faces are never lost).
+template <int dim>
+std::vector<char> mesh_marks(const MeshData& mesh, const Lattice<dim>& L) {
+  std::vector<char> mark(L.size(), 0);
+  constexpr double tol = 1e-12;
+  for (std::size_t c = 0; c < mesh.num_cells(); ++c) {
+    const long long* v = &mesh.cells[c * (dim + 1)];
+    const Vec<dim> X0(&mesh.coords[v[0] * dim]);
+    Mat<dim> T;
+    Vec<dim> lo = X0, hi = X0;
+    for (int k = 1; k <= dim; ++k) {
+      const Vec<dim> Xk(&mesh.coords[v[k] * dim]);
+      T.col(k - 1) = Xk - X0;
+      lo = lo.cwiseMin(Xk);
+      hi = hi.cwiseMax(Xk);
+    }
+    const Mat<dim> Tinv = T.inverse();
+    long long mlo[dim], mhi[dim];
+    for (int d = 0; d < dim; ++d) {
+      mlo[d] = std::max(L.m_lo[d], static_cast<long long>(std::ceil(lo[d] / L.h - 0.5)) - 1);
+      mhi[d] = std::min(L.m_lo[d] + L.count[d] - 1, static_cast<long long>(std::floor(hi[d] / L.h - 0.5)) + 1);
+    }
+    for_each_point<dim>(mlo, mhi, [&](const long long* m) {
+      const Vec<dim> lam = Tinv * (L.point(m) - X0);
+      if (lam.minCoeff() >= -tol && lam.sum() <= 1.0 + tol) mark[L.linear(m)] = 1;
+    });
+  }
+  return mark;
+}
+
+}  // namespace
+
+double sampling_shape_measure(const SamplingShape& s, int dim) {
+  validate_shape(s, dim);
+  if (is_box(s.kind)) {
+    double v = 1.0;
+    for (double e : s.size) v *= e;
+    return v;
+  }
+  if (s.kind == "mesh") return total_measure(*s.mesh);
+  if (s.kind == "sdf") return std::numeric_limits<double>::quiet_NaN();
+  const double R = s.outer_radius, r = s.inner_radius;
+  if (s.kind == "disk") return kPi * R * R;
+  if (s.kind == "sphere") return 4.0 / 3.0 * kPi * R * R * R;
+  return (s.kind == "ring" ? 1.0 : 0.5) * kPi * (R * R - r * r);
+}
+
+template <int dim>
+Particles<dim> sample_particles(const SamplingShape& shape, double dx, int ppc, double density,
+                                int body_id, int material_id) {
+  validate_shape(shape, dim);
+  require_positive("dx", dx);
+  require_positive("density", density);
+  int s = 0;  // points per axis and cell
+  for (int k = 1; k <= (dim == 2 ? 4 : 3); ++k)
+    if (static_cast<int>(std::pow(k, dim) + 0.5) == ppc) s = k;
+  if (s == 0)
+    bad("ppc", std::to_string(ppc), dim == 2 ? "one of 1, 4, 9, 16 in 2D" : "one of 1, 8, 27 in 3D");
+  if (body_id < 0) bad("body_id", std::to_string(body_id), ">= 0");
+  if (material_id < 0) bad("material_id", std::to_string(material_id), ">= 0");
+
+  Vec<dim> lo, hi;
+  bounding_box<dim>(shape, lo, hi);
+  Lattice<dim> L;
+  L.h = dx / s;
+  double candidates = 1.0;
+  for (int d = 0; d < dim; ++d) {
+    const double c_lo = std::floor(lo[d] / dx), c_hi = std::ceil(hi[d] / dx);
+    candidates *= std::max(1.0, c_hi - c_lo) * s;
+    if (!(candidates <= kMaxCandidates))  // also catches huge coordinates / dx
+      bad("dx", fmt(dx), "a larger value (the shape '" + shape.kind + "' would need more than " +
+                             fmt(kMaxCandidates) + " candidate points)");
+    L.m_lo[d] = static_cast<long long>(c_lo) * s;
+    L.count[d] = static_cast<long long>(std::max(1.0, c_hi - c_lo)) * s;
+  }
+
+  std::vector<char> mark;
+  if (shape.kind == "mesh") mark = mesh_marks<dim>(*shape.mesh, L);
+  const Vec<dim> c = center_of<dim>(shape);
+  std::vector<Vec<dim>> kept;
+  long long last[dim];
+  for (int d = 0; d < dim; ++d) last[d] = L.m_lo[d] + L.count[d] - 1;
+  for_each_point<dim>(L.m_lo, last, [&](const long long* m) {
+    const Vec<dim> x = L.point(m);
+    if (shape.kind == "mesh" ? mark[L.linear(m)] != 0 : inside_function<dim>(shape, c, x) < 0.0)
+      kept.push_back(x);
+  });
+  if (kept.empty())
+    throw std::invalid_argument("shape '" + shape.kind + "' with dx " + fmt(dx) +
+                                " produced no particles (ppc " + std::to_string(ppc) +
+                                "): expected the shape to contain at least one sub-cell centre; "
+                                "use a smaller dx or a larger ppc");
+
+  Particles<dim> p = allocate_particles<dim>(kept.size());
+  auto x = Kokkos::create_mirror_view(p.x);
+  auto mass = Kokkos::create_mirror_view(p.mass);
+  auto vol = Kokkos::create_mirror_view(p.volume0);
+  auto body = Kokkos::create_mirror_view(p.body);
+  auto mat = Kokkos::create_mirror_view(p.material);
+  const double v0 = std::pow(dx, dim) / ppc;
+  for (std::size_t q = 0; q < kept.size(); ++q) {
+    for (int d = 0; d < dim; ++d) x(q, d) = kept[q][d];
+    vol(q) = v0;
+    mass(q) = density * v0;
+    body(q) = body_id;
+    mat(q) = material_id;
+  }
+  Kokkos::deep_copy(p.x, x);
+  Kokkos::deep_copy(p.mass, mass);
+  Kokkos::deep_copy(p.volume0, vol);
+  Kokkos::deep_copy(p.body, body);
+  Kokkos::deep_copy(p.material, mat);
+  return p;
+}
+
+template <int dim>
+std::string sampling_report(const SamplingShape& shape, const Particles<dim>& particles, double dx,
+                            int ppc) {
+  auto mass = particles.mass;
+  auto vol = particles.volume0;
+  double total_mass = 0.0, total_volume = 0.0;
+  Kokkos::parallel_reduce(
+      "mpm_sampling_mass", Kokkos::RangePolicy<ExecSpace>(0, particles.size()),
+      KOKKOS_LAMBDA(const std::size_t q, double& acc) { acc += mass(q); }, total_mass);
+  Kokkos::parallel_reduce(
+      "mpm_sampling_volume", Kokkos::RangePolicy<ExecSpace>(0, particles.size()),
+      KOKKOS_LAMBDA(const std::size_t q, double& acc) { acc += vol(q); }, total_volume);
+  std::string line = "shape '" + shape.kind + "': " + std::to_string(particles.size()) +
+                     " particles (dx " + fmt(dx) + ", ppc " + std::to_string(ppc) + "), volume " +
+                     fmt(total_volume);
+  if (shape.kind != "sdf") {
+    const double exact = sampling_shape_measure(shape, dim);
+    char rel[32];
+    std::snprintf(rel, sizeof rel, "%+.2f%%", 100.0 * (total_volume / exact - 1.0));
+    line += " (shape " + fmt(exact) + ", " + rel + ")";
+  }
+  return line + ", mass " + fmt(total_mass);
+}
+
+template Particles<2> sample_particles<2>(const SamplingShape&, double, int, double, int, int);
+template Particles<3> sample_particles<3>(const SamplingShape&, double, int, double, int, int);
+template std::string sampling_report<2>(const SamplingShape&, const Particles<2>&, double, int);
+template std::string sampling_report<3>(const SamplingShape&, const Particles<3>&, double, int);
+
+}  // namespace bfemp

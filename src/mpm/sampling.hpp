@@ -1,0 +1,64 @@
+#pragma once
+// Regular sampling of material points inside a shape. Candidate points are the
+// sub-cell centres of the lattice dx * Z^dim aligned with the origin
+// (0,...,0): with s = ppc^(1/dim) points per axis and cell, the points are
+// x_d = (m_d + 1/2) dx / s for integer m_d, so particles of every body line up
+// with the same background grid (grid_covering in mpm/grid.hpp uses the same
+// lattice). Each kept point represents its sub-cell: volume0 = dx^dim / ppc,
+// mass = density * volume0, v = 0, F = I, C = 0.
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "io/mesh_data.hpp"
+#include "mpm/particles.hpp"
+
+namespace bfemp {
+
+struct SamplingShape {
+  // "box"        2D rectangle or 3D box: center, size (dim extents > 0);
+  //              "rectangle" is accepted as a 2D synonym;
+  // "disk"       2D, "sphere" 3D: center, outer_radius;
+  // "ring"       2D annulus: center, inner_radius < outer_radius;
+  // "half-ring"  2D, the part of the ring with y > center[1];
+  // "mesh"       the closed region covered by the simplices of *mesh
+  //              (mesh->dim == dim; a point in any cell, faces included);
+  // "sdf"        inside where sdf(x) < 0; center and size give the bounding
+  //              box that is scanned (the shape must lie inside it).
+  // Analytic shapes keep points strictly inside (a point exactly on the
+  // boundary is dropped).
+  std::string kind;
+  std::vector<double> center;  // dim entries; empty means the origin
+  std::vector<double> size;    // box, sdf: full extents along each axis
+  double inner_radius = 0.0;   // ring, half-ring
+  double outer_radius = 0.0;   // disk, sphere, ring, half-ring
+  const MeshData* mesh = nullptr;               // mesh (not owned)
+  std::function<double(const double*)> sdf;     // sdf: x has dim entries
+};
+
+// Samples `shape` with ppc particles per full cell of side dx; every particle
+// gets body_id and material_id. ppc must be 1, 4, 9 or 16 in 2D and 1, 8 or 27
+// in 3D. Throws std::invalid_argument naming the field and its value for an
+// unknown kind or one not available in dim, a center/size of the wrong length,
+// non-positive or non-finite dx, density, sizes or radii, inner_radius >=
+// outer_radius, a missing mesh/sdf, negative ids, a dx so small that more than
+// 1e8 candidate points would be tested, and an empty result ("shape 'ring'
+// with dx 0.1 produced no particles ...").
+template <int dim>
+Particles<dim> sample_particles(const SamplingShape& shape, double dx, int ppc, double density,
+                                int body_id, int material_id);
+
+// Exact area (2D) or volume (3D) of the shape: analytic for box, disk,
+// sphere, ring and half-ring, total_measure(*mesh) for mesh, NaN for sdf.
+// Expects a shape that sample_particles accepts.
+double sampling_shape_measure(const SamplingShape& shape, int dim);
+
+// One line for the run log, e.g.
+//   "shape 'disk': 3132 particles (dx 0.02, ppc 4), volume 0.3132 (shape 0.31416, -0.31%),
+//    mass 313.2"
+// (the shape measure is left out for kind "sdf").
+template <int dim>
+std::string sampling_report(const SamplingShape& shape, const Particles<dim>& particles, double dx,
+                            int ppc);
+
+}  // namespace bfemp

@@ -1,0 +1,67 @@
+#pragma once
+// One term of the incremental potential's elastic part (FEM elements, MPM
+// particles; later barrier and friction), seen by the Newton solver through
+// value, gradient, PSD Hessian assembly, line-search step bound and the node
+// couplings its Hessian needs in the system graph.
+#include <string>
+#include <vector>
+
+#include "kernels/deformation_energy.hpp"
+#include "solver/tpetra_types.hpp"
+
+namespace bfemp {
+
+using LocalMatrix = Matrix::local_matrix_device_type;
+using DofView = Kokkos::View<double*, MemSpace>;
+using ConstDofView = Kokkos::View<const double*, MemSpace>;
+using MaskView = Kokkos::View<const int*, MemSpace>;
+
+template <int dim>
+class EnergyTerm {
+ public:
+  virtual ~EnergyTerm() = default;
+  virtual std::string name() const = 0;
+  // Appends node pairs a * n_nodes + b (both orders) the Hessian may touch.
+  virtual void add_couplings(std::vector<long long>& keys, LO n_nodes) const = 0;
+  virtual double energy(ConstDofView x) const = 0;
+  // grad += scale * dE/dx
+  virtual void gradient(ConstDofView x, double scale, DofView grad) const = 0;
+  // grad += scale * dE/dx; A += scale * PSD Hessian on free rows; couplings to
+  // prescribed DOFs go to rhs (see deformation_assemble).
+  virtual void assemble(ConstDofView x, double scale, DofView grad, const LocalMatrix& A, MaskView prescribed,
+                        ConstDofView dx_prescribed, DofView rhs) const = 0;
+  // Largest step along p keeping the term defined (inf if unbounded).
+  virtual double max_step(ConstDofView x, ConstDofView p) const = 0;
+};
+
+// Elasticity over deformation stencils (FEM elements or MPM particles).
+template <int dim, int nv>
+class DeformationTerm : public EnergyTerm<dim> {
+ public:
+  DeformationTerm(std::string name, DeformationStencils<dim, nv> s) : name_(std::move(name)), s_(s) {}
+  std::string name() const override { return name_; }
+  void set_stencils(DeformationStencils<dim, nv> s) { s_ = s; }
+  const DeformationStencils<dim, nv>& stencils() const { return s_; }
+
+  void add_couplings(std::vector<long long>& keys, LO n_nodes) const override {
+    auto nodes = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), s_.nodes);
+    for (std::size_t q = 0; q < nodes.extent(0); ++q)
+      for (int a = 0; a < nv; ++a)
+        for (int b = 0; b < nv; ++b) keys.push_back(static_cast<long long>(nodes(q, a)) * n_nodes + nodes(q, b));
+  }
+  double energy(ConstDofView x) const override { return deformation_energy(s_, x); }
+  void gradient(ConstDofView x, double scale, DofView grad) const override {
+    deformation_gradient(s_, x, scale, grad);
+  }
+  void assemble(ConstDofView x, double scale, DofView grad, const LocalMatrix& A, MaskView prescribed,
+                ConstDofView dx_prescribed, DofView rhs) const override {
+    deformation_assemble(s_, x, scale, grad, A, prescribed, dx_prescribed, rhs);
+  }
+  double max_step(ConstDofView x, ConstDofView p) const override { return deformation_max_step(s_, x, p); }
+
+ private:
+  std::string name_;
+  DeformationStencils<dim, nv> s_;
+};
+
+}  // namespace bfemp
