@@ -8,7 +8,7 @@
 #include "sim/fem_simulation.hpp"
 #include "solver/linear_solver.hpp"
 
-namespace bfemp::testing {
+namespace bfemp::fixtures {
 
 // A block [0,1]^dim (height `height` along y) meshed with element size h.
 template <int dim>
@@ -58,4 +58,4 @@ double mass_mean(const XView& x, const MView& node_mass, int c) {
   return sx / sm;
 }
 
-}  // namespace bfemp::testing
+}  // namespace bfemp::fixtures

@@ -5,7 +5,7 @@
 #include "kernels/deformation_energy.hpp"
 
 using namespace bfemp;
-using namespace bfemp::testing;
+using namespace bfemp::fixtures;
 
 namespace {
 

@@ -6,7 +6,7 @@
 #include "common/fem_fixtures.hpp"
 
 using namespace bfemp;
-using namespace bfemp::testing;
+using namespace bfemp::fixtures;
 
 namespace {
 
