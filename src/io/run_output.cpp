@@ -31,7 +31,7 @@ std::string prepare_dir(const std::string& dir) {
 }  // namespace
 
 template <int dim>
-RunOutput<dim>::RunOutput(const std::string& dir, const Scene& scene, const FemSimulation<dim>& sim)
+RunOutput<dim>::RunOutput(const std::string& dir, const Scene& scene, const Simulation<dim>& sim)
     : dir_(prepare_dir(dir)),
       h5_(dir + "/bfemp.h5"),
       xdmf_(dir + "/bfemp.xdmf", "bfemp.h5"),
@@ -48,7 +48,7 @@ RunOutput<dim>::RunOutput(const std::string& dir, const Scene& scene, const FemS
 }
 
 template <int dim>
-void RunOutput<dim>::write_frame(const FemSimulation<dim>& sim) {
+void RunOutput<dim>::write_frame(const Simulation<dim>& sim) {
   const auto& mesh = sim.mesh();
   const std::size_t nn = mesh.num_nodes(), ne = mesh.num_cells();
   auto x = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), sim.positions());

@@ -12,7 +12,7 @@
 #include "io/hdf5_frames.hpp"
 #include "io/scene.hpp"
 #include "io/xdmf_writer.hpp"
-#include "sim/fem_simulation.hpp"
+#include "sim/simulation.hpp"
 
 namespace bfemp {
 
@@ -23,8 +23,8 @@ std::vector<double> diagnostics_row(const StepReport& r);
 template <int dim>
 class RunOutput {
  public:
-  RunOutput(const std::string& dir, const Scene& scene, const FemSimulation<dim>& sim);
-  void write_frame(const FemSimulation<dim>& sim);
+  RunOutput(const std::string& dir, const Scene& scene, const Simulation<dim>& sim);
+  void write_frame(const Simulation<dim>& sim);
   void write_diagnostics(const StepReport& r) { csv_.write_row(diagnostics_row(r)); }
   void close() { h5_.close(); }
   int frames_written() const { return frame_; }

@@ -163,9 +163,9 @@ Scene load_scene_from_string(const std::string& yaml, const std::string& base_di
 }
 
 template <int dim>
-FemSetup<dim> build_fem_setup(const Scene& scene) {
+SimulationSetup<dim> build_fem_setup(const Scene& scene) {
   const ParameterList& p = scene.params;
-  FemSetup<dim> setup;
+  SimulationSetup<dim> setup;
   std::vector<std::string> mat_names;
   const auto& mats = p.sublist("Materials");
   for (auto it = mats.begin(); it != mats.end(); ++it) {
@@ -243,8 +243,8 @@ FemSetup<dim> build_fem_setup(const Scene& scene) {
   return setup;
 }
 
-template FemSetup<2> build_fem_setup<2>(const Scene&);
-template FemSetup<3> build_fem_setup<3>(const Scene&);
+template SimulationSetup<2> build_fem_setup<2>(const Scene&);
+template SimulationSetup<3> build_fem_setup<3>(const Scene&);
 
 std::string scene_summary(const Scene& scene) {
   const auto& p = scene.params;

@@ -16,7 +16,7 @@ RunSummary run_dim(const Scene& scene, const std::string& dir, const Teuchos::RC
                    std::ostream& log) {
   Kokkos::Timer wall;
   const RunControl rc = scene.run_control();
-  FemSimulation<dim> sim(build_fem_setup<dim>(scene), comm);
+  Simulation<dim> sim(build_fem_setup<dim>(scene), comm);
   const auto& mesh = sim.mesh();
   log << "FEM: " << mesh.num_nodes() << " nodes, " << mesh.num_cells() << " elements, "
       << mesh.num_nodes() * dim << " DOFs; linear solver: " << sim.newton().linear_solver().describe()

@@ -5,16 +5,16 @@
 
 #include "io/shape_mesher.hpp"
 #include "materials/lame.hpp"
-#include "sim/fem_simulation.hpp"
+#include "sim/simulation.hpp"
 #include "solver/linear_solver.hpp"
 
 namespace bfemp::fixtures {
 
 // A block [0,1]^dim (height `height` along y) meshed with element size h.
 template <int dim>
-FemSetup<dim> block_setup(double h, double E = 1e5, double nu = 0.3, double rho = 1000.0,
+SimulationSetup<dim> block_setup(double h, double E = 1e5, double nu = 0.3, double rho = 1000.0,
                           double height = 1.0, const std::string& solver = "Cholmod") {
-  FemSetup<dim> s;
+  SimulationSetup<dim> s;
   ShapeSpec spec;
   spec.kind = dim == 2 ? "rectangle" : "box";
   spec.center = dim == 2 ? std::vector<double>{0.5, height / 2} : std::vector<double>{0.5, height / 2, 0.5};
@@ -37,7 +37,7 @@ FemSetup<dim> block_setup(double h, double E = 1e5, double nu = 0.3, double rho 
 
 // Prescribes the node set `set` of body 0 with the given segments.
 template <int dim>
-void prescribe(FemSetup<dim>& s, const std::string& set, std::vector<MotionSegment> segments = {MotionSegment{}}) {
+void prescribe(SimulationSetup<dim>& s, const std::string& set, std::vector<MotionSegment> segments = {MotionSegment{}}) {
   PrescribedMotion m;
   m.name = set;
   for (long long n : s.bodies[0].mesh.node_sets.at(set)) m.nodes.push_back(static_cast<LO>(n));

@@ -10,13 +10,13 @@ using namespace bfemp::fixtures;
 namespace {
 
 // Block clamped at its base, given a shear velocity profile v_x = v0 * y.
-std::unique_ptr<FemSimulation<2>> vibrating_block(const TimeIntegrator& ti, double dt) {
+std::unique_ptr<Simulation<2>> vibrating_block(const TimeIntegrator& ti, double dt) {
   auto s = block_setup<2>(0.25, 1e5, 0.3, 1000.0);
   s.integrator = ti;
   s.dt = dt;
   s.newton.eps_d = 1e-10;
   prescribe(s, "bottom");
-  auto sim = std::make_unique<FemSimulation<2>>(s, comm());
+  auto sim = std::make_unique<Simulation<2>>(s, comm());
   auto x = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), sim->positions());
   auto v = Kokkos::create_mirror_view(sim->velocities());
   Kokkos::deep_copy(v, 0.0);
@@ -78,7 +78,7 @@ TEST(FemMomentum, LinearMomentumConservedWithoutGravityAndBoundaries) {
   auto s = block_setup<2>(0.2);
   s.integrator = TimeIntegrator::newmark();
   s.dt = 5e-3;
-  FemSimulation<2> sim(s, comm());
+  Simulation<2> sim(s, comm());
   auto x = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), sim.positions());
   auto v = Kokkos::create_mirror_view(sim.velocities());
   // Translation + spin + a compressive mode: the body deforms and rotates.
@@ -111,7 +111,7 @@ TEST(FemInversion, ExtremeCompressionInOneHugeStepNeverInverts) {
   down.velocity = {0.0, -0.9, 0.0};
   down.duration = 1.0;
   prescribe(s, "top", {down, MotionSegment{}});
-  FemSimulation<2> sim(s, comm());
+  Simulation<2> sim(s, comm());
   int iterates = 0;
   double min_J_seen = 1;
   const auto& mesh = sim.mesh();

@@ -18,7 +18,7 @@ double simulated_drop(const TimeIntegrator& ti, double dt, int n, double* recurr
   s.integrator = ti;
   s.gravity = {0.0, g, 0.0};
   s.dt = dt;
-  FemSimulation<2> sim(s, comm());
+  Simulation<2> sim(s, comm());
   auto mass = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), sim.mesh().node_mass);
   auto x0 = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), sim.positions());
   const double y0 = mass_mean<2>(x0, mass, 1);

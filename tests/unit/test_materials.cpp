@@ -155,11 +155,11 @@ TYPED_TEST(MaterialTest, DispatchAndProjectedStressDerivative) {
 
 // Neo-Hookean specific properties, in 2D and 3D.
 template <class T>
-class NeoHookeanTest : public ::testing::Test {};
+class MaterialNeoHookeanTest : public ::testing::Test {};
 using Dims = ::testing::Types<std::integral_constant<int, 2>, std::integral_constant<int, 3>>;
-TYPED_TEST_SUITE(NeoHookeanTest, Dims);
+TYPED_TEST_SUITE(MaterialNeoHookeanTest, Dims);
 
-TYPED_TEST(NeoHookeanTest, ProjectedEqualsExactWhereExactIsPsd) {
+TYPED_TEST(MaterialNeoHookeanTest, ProjectedEqualsExactWhereExactIsPsd) {
   constexpr int dim = TypeParam::value;
   std::mt19937 rng(7);
   for (const LameParameters& p : lame_sets()) {
@@ -184,7 +184,7 @@ TYPED_TEST(NeoHookeanTest, ProjectedEqualsExactWhereExactIsPsd) {
   }
 }
 
-TYPED_TEST(NeoHookeanTest, EnergyInfiniteForInvertedOrFlat) {
+TYPED_TEST(MaterialNeoHookeanTest, EnergyInfiniteForInvertedOrFlat) {
   constexpr int dim = TypeParam::value;
   constexpr double inf = std::numeric_limits<double>::infinity();
   const LameParameters p = lame_from_young(1e6, 0.3);
@@ -199,7 +199,7 @@ TYPED_TEST(NeoHookeanTest, EnergyInfiniteForInvertedOrFlat) {
   EXPECT_GT(NeoHookean::energy<dim>(F, p), 100.0 * p.mu);
 }
 
-TYPED_TEST(NeoHookeanTest, RotationInvariance) {
+TYPED_TEST(MaterialNeoHookeanTest, RotationInvariance) {
   constexpr int dim = TypeParam::value;
   std::mt19937 rng(99);
   for (const LameParameters& p : lame_sets())
@@ -212,7 +212,7 @@ TYPED_TEST(NeoHookeanTest, RotationInvariance) {
     }
 }
 
-TYPED_TEST(NeoHookeanTest, SmallStrainMatchesHookesLaw) {
+TYPED_TEST(MaterialNeoHookeanTest, SmallStrainMatchesHookesLaw) {
   constexpr int dim = TypeParam::value;
   std::mt19937 rng(3);
   for (const LameParameters& p : lame_sets()) {

@@ -52,7 +52,7 @@ TEST(PrescribedMotion, RigidlyRotatedBodyStaysUndeformed) {
   for (LO n = 0; n < static_cast<LO>(s.bodies[0].mesh.num_nodes()); ++n) all.nodes.push_back(n);
   all.segments = {spin};
   s.motions.push_back(all);
-  FemSimulation<2> sim(s, fixtures::comm());
+  Simulation<2> sim(s, fixtures::comm());
   for (int k = 0; k < 10; ++k) {
     const StepReport r = sim.step();
     EXPECT_NEAR(r.elastic, 0.0, 1e-9);

@@ -1,0 +1,196 @@
+#pragma once
+// Kokkos kernels of the MPM particle-grid transfers (paper Tables 1-3):
+// grid activation (active nodes numbered after the FEM nodes), P2G of mass and
+// momentum, the particles' deformation stencils for the elastic energy
+// (F_q(x) = sum_i x_i (grad w_iq)^T F_q^n), and G2P of velocity, position, F
+// and the APIC affine matrix. Grid quantities of active node k live at system
+// node first + k; system vectors are node-interleaved (node*dim + c).
+#include <Kokkos_Core.hpp>
+#include <Kokkos_ScatterView.hpp>
+
+#include "kernels/deformation_energy.hpp"
+#include "mpm/bspline.hpp"
+#include "mpm/grid.hpp"
+#include "mpm/particles.hpp"
+#include "mpm/transfer_scheme.hpp"
+
+namespace bfemp {
+
+template <int dim>
+KOKKOS_INLINE_FUNCTION Vec<dim> particle_position(const Particles<dim>& p, LO q) {
+  Vec<dim> x;
+  for (int d = 0; d < dim; ++d) x(d) = p.x(q, d);
+  return x;
+}
+
+// Index of a particle whose stencil leaves the grid (the largest), or -1.
+template <int dim>
+LO particle_outside(const GridSpec<dim>& grid, const Particles<dim>& p) {
+  LO worst = -1;
+  Kokkos::parallel_reduce(
+      "mpm_outside", Kokkos::RangePolicy<ExecSpace>(0, p.size()),
+      KOKKOS_LAMBDA(const LO q, LO& acc) {
+        if (!grid.contains(particle_position(p, q)) && q > acc) acc = q;
+      },
+      Kokkos::Max<LO>(worst));
+  return worst < 0 ? -1 : worst;
+}
+
+// Marks the nodes touched by particle stencils and numbers them: system_node(n)
+// = first + rank among active nodes, or -1. Returns the active count and fills
+// grid_node(k) = linear grid index of active node k (resized when too small).
+template <int dim>
+LO activate_grid(const GridSpec<dim>& grid, const Particles<dim>& p, LO first,
+                 Kokkos::View<LO*, MemSpace> system_node, Kokkos::View<LO*, MemSpace>& grid_node) {
+  constexpr int ns = bspline_stencil_size<dim>;
+  Kokkos::deep_copy(system_node, 0);
+  Kokkos::parallel_for(
+      "mpm_mark_nodes", Kokkos::RangePolicy<ExecSpace>(0, p.size()), KOKKOS_LAMBDA(const LO q) {
+        const auto st = bspline_stencil(grid, particle_position(p, q));
+        for (int a = 0; a < ns; ++a) system_node(node_index(grid, st, a)) = 1;  // benign race
+      });
+  LO count = 0;
+  Kokkos::parallel_scan(
+      "mpm_number_nodes", Kokkos::RangePolicy<ExecSpace>(0, system_node.extent(0)),
+      KOKKOS_LAMBDA(const LO n, LO& offset, const bool final) {
+        const LO flag = system_node(n);
+        if (final) system_node(n) = flag ? first + offset : -1;
+        offset += flag;
+      },
+      count);
+  if (static_cast<LO>(grid_node.extent(0)) < count) grid_node = Kokkos::View<LO*, MemSpace>("mpm_grid_node", count);
+  auto gn = grid_node;
+  Kokkos::parallel_for(
+      "mpm_active_list", Kokkos::RangePolicy<ExecSpace>(0, system_node.extent(0)), KOKKOS_LAMBDA(const LO n) {
+        if (system_node(n) >= 0) gn(system_node(n) - first) = n;
+      });
+  return count;
+}
+
+// P2G: node mass and momentum (m v) of active node k = system id - first via
+// ScatterViews (persistent, created by the caller on the target views).
+template <int dim, class MassScatter, class MomentumScatter>
+void p2g(const GridSpec<dim>& grid, const Particles<dim>& p, TransferScheme scheme,
+         Kokkos::View<const LO*, MemSpace> system_node, LO first, MassScatter mass, MomentumScatter momentum) {
+  constexpr int ns = bspline_stencil_size<dim>;
+  const bool apic = scheme == TransferScheme::APIC;
+  Kokkos::parallel_for(
+      "mpm_p2g", Kokkos::RangePolicy<ExecSpace>(0, p.size()), KOKKOS_LAMBDA(const LO q) {
+        auto m_acc = mass.access();
+        auto p_acc = momentum.access();
+        const Vec<dim> xp = particle_position(p, q);
+        const auto st = bspline_stencil(grid, xp);
+        const double mp = p.mass(q);
+        for (int a = 0; a < ns; ++a) {
+          const LO gnode = node_index(grid, st, a);
+          const LO k = system_node(gnode) - first;
+          const double w = weight(st, a);
+          m_acc(k) += w * mp;
+          const Vec<dim> dxi = grid.node_position(gnode) - xp;
+          for (int c = 0; c < dim; ++c) {
+            double v = p.v(q, c);
+            if (apic)
+              for (int d = 0; d < dim; ++d) v += p.C(q, c, d) * dxi(d);
+            p_acc(k * dim + c) += w * mp * v;
+          }
+        }
+      });
+}
+
+// Deformation stencils of the particles: nodes = system ids of the stencil,
+// g_a = F_q^n^T grad w_a, volume = rest volume.
+template <int dim>
+void mpm_stencils(const GridSpec<dim>& grid, const Particles<dim>& p, Kokkos::View<const LO*, MemSpace> system_node,
+                  const DeformationStencils<dim, bspline_stencil_size<dim>>& s) {
+  constexpr int ns = bspline_stencil_size<dim>;
+  Kokkos::parallel_for(
+      "mpm_stencils", Kokkos::RangePolicy<ExecSpace>(0, p.size()), KOKKOS_LAMBDA(const LO q) {
+        const auto st = bspline_stencil(grid, particle_position(p, q));
+        for (int a = 0; a < ns; ++a) {
+          s.nodes(q, a) = system_node(node_index(grid, st, a));
+          const Vec<dim> gw = weight_gradient(st, a);
+          for (int j = 0; j < dim; ++j) {
+            double v = 0;
+            for (int i = 0; i < dim; ++i) v += p.F(q, i, j) * gw(i);
+            s.g(q, a, j) = v;
+          }
+        }
+        s.volume(q) = p.volume0(q);
+        s.material(q) = p.material(q);
+      });
+}
+
+// G2P (Tables 1-3): x_p = sum w x~_i, v_p (PIC/APIC: sum w v~_i; FLIP: v_p +
+// sum w (v~_i - v_i^n)), F_p = sum x~_i grad w^T F_p^n, APIC B_p (Table 1)
+// stored as C_p = B_p D_p^-1 with D_p = dx^2/4 I.
+template <int dim>
+void g2p(const GridSpec<dim>& grid, const Particles<dim>& p, TransferScheme scheme,
+         Kokkos::View<const LO*, MemSpace> system_node, Kokkos::View<const double*, MemSpace> x_new,
+         Kokkos::View<const double*, MemSpace> v_new, Kokkos::View<const double*, MemSpace> v_old) {
+  constexpr int ns = bspline_stencil_size<dim>;
+  const double inv_D = 4.0 / (grid.dx * grid.dx);
+  Kokkos::parallel_for(
+      "mpm_g2p", Kokkos::RangePolicy<ExecSpace>(0, p.size()), KOKKOS_LAMBDA(const LO q) {
+        const Vec<dim> xp = particle_position(p, q);
+        const auto st = bspline_stencil(grid, xp);
+        Vec<dim> xn = Vec<dim>::Zero(), vn = Vec<dim>::Zero(), dv = Vec<dim>::Zero();
+        Mat<dim> G = Mat<dim>::Zero();  // sum x~_i grad w^T
+        for (int a = 0; a < ns; ++a) {
+          const LO k = system_node(node_index(grid, st, a));
+          const double w = weight(st, a);
+          const Vec<dim> gw = weight_gradient(st, a);
+          for (int c = 0; c < dim; ++c) {
+            xn(c) += w * x_new(k * dim + c);
+            vn(c) += w * v_new(k * dim + c);
+            dv(c) += w * (v_new(k * dim + c) - v_old(k * dim + c));
+            for (int j = 0; j < dim; ++j) G(c, j) += x_new(k * dim + c) * gw(j);
+          }
+        }
+        if (scheme == TransferScheme::APIC) {
+          Mat<dim> B = Mat<dim>::Zero();
+          for (int a = 0; a < ns; ++a) {
+            const LO gnode = node_index(grid, st, a);
+            const LO k = system_node(gnode);
+            const double w = weight(st, a);
+            Vec<dim> vi, xt;
+            for (int c = 0; c < dim; ++c) {
+              vi(c) = v_new(k * dim + c);
+              xt(c) = x_new(k * dim + c);
+            }
+            const Vec<dim> xi = grid.node_position(gnode);
+            B += 0.5 * w * (vi * (xi - xp + xt - xn).transpose() + (xi - xp - xt + xn) * vi.transpose());
+          }
+          for (int i = 0; i < dim; ++i)
+            for (int j = 0; j < dim; ++j) p.C(q, i, j) = B(i, j) * inv_D;
+        }
+        Mat<dim> Fn;
+        for (int i = 0; i < dim; ++i)
+          for (int j = 0; j < dim; ++j) Fn(i, j) = p.F(q, i, j);
+        const Mat<dim> F1 = G * Fn;
+        for (int i = 0; i < dim; ++i)
+          for (int j = 0; j < dim; ++j) p.F(q, i, j) = F1(i, j);
+        for (int c = 0; c < dim; ++c) {
+          p.v(q, c) = scheme == TransferScheme::FLIP ? p.v(q, c) + dv(c) : vn(c);
+          p.x(q, c) = xn(c);
+        }
+      });
+}
+
+// Smallest det F_p over the particles (1 when there are none).
+template <int dim>
+double mpm_particle_min_J(const Particles<dim>& p) {
+  double jmin = 1;
+  Kokkos::parallel_reduce(
+      "mpm_min_J", Kokkos::RangePolicy<ExecSpace>(0, p.size()),
+      KOKKOS_LAMBDA(const LO q, double& acc) {
+        Mat<dim> F;
+        for (int i = 0; i < dim; ++i)
+          for (int j = 0; j < dim; ++j) F(i, j) = p.F(q, i, j);
+        const double j = F.determinant();
+        if (j < acc) acc = j;
+      },
+      Kokkos::Min<double>(jmin));
+  return jmin;
+}
+
+}  // namespace bfemp

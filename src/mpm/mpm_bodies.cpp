@@ -1,0 +1,138 @@
+#include "mpm/mpm_bodies.hpp"
+
+#include <algorithm>
+#include <stdexcept>
+#include <unordered_set>
+
+namespace bfemp {
+
+template <int dim>
+void MpmElasticityTerm<dim>::add_couplings(std::vector<long long>& keys, LO n_nodes) const {
+  constexpr int ns = bspline_stencil_size<dim>;
+  auto nodes = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), this->stencils().nodes);
+  std::unordered_set<LO> seen;  // a stencil is identified by its first node
+  for (std::size_t q = 0; q < nodes.extent(0); ++q) {
+    if (!seen.insert(nodes(q, 0)).second) continue;
+    for (int a = 0; a < ns; ++a)
+      for (int b = 0; b < ns; ++b) keys.push_back(static_cast<long long>(nodes(q, a)) * n_nodes + nodes(q, b));
+  }
+}
+
+template <int dim>
+MpmBodies<dim>::MpmBodies(MpmSetup<dim> setup, Kokkos::View<MaterialParams*, MemSpace> materials)
+    : setup_(std::move(setup)), materials_(materials) {
+  const std::size_t np = setup_.particles.size();
+  system_node_ = Kokkos::View<LO*, MemSpace>("mpm_system_node", setup_.grid.num_nodes());
+  stencils_.nodes = decltype(stencils_.nodes)("mpm_stencil_nodes", np);
+  stencils_.g = decltype(stencils_.g)("mpm_stencil_g", np);
+  stencils_.volume = decltype(stencils_.volume)("mpm_stencil_volume", np);
+  stencils_.material = decltype(stencils_.material)("mpm_stencil_material", np);
+  stencils_.materials = materials_;
+  term_ = std::make_unique<MpmElasticityTerm<dim>>("mpm elasticity", stencils_);
+}
+
+template <int dim>
+LO MpmBodies<dim>::begin_step(LO first, long step) {
+  const auto& grid = setup_.grid;
+  const auto& p = setup_.particles;
+  const LO out = particle_outside(grid, p);
+  if (out >= 0) {
+    auto x = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), p.x);
+    std::string pos;
+    for (int d = 0; d < dim; ++d) pos += (d ? ", " : "") + std::to_string(x(out, d));
+    throw std::runtime_error("step " + std::to_string(step) + ": MPM particle " + std::to_string(out) +
+                             " at (" + pos + ") left the grid domain (its B-spline stencil needs half a cell "
+                             "inside the grid); enlarge the scene's MPM grid domain");
+  }
+  first_ = first;
+  active_ = activate_grid(grid, p, first, system_node_, grid_node_);
+  if (static_cast<LO>(mass_.extent(0)) < active_) {
+    const std::size_t cap = static_cast<std::size_t>(active_) * 5 / 4 + 16;  // grow, not per step
+    mass_ = Kokkos::View<double*, MemSpace>("mpm_grid_mass", cap);
+    momentum_ = Kokkos::View<double*, MemSpace>("mpm_grid_momentum", cap * dim);
+    mass_scatter_ = Scatter(mass_);
+    momentum_scatter_ = Scatter(momentum_);
+  }
+  Kokkos::deep_copy(Kokkos::subview(mass_, std::make_pair(0, active_)), 0.0);
+  Kokkos::deep_copy(Kokkos::subview(momentum_, std::make_pair(0, active_ * dim)), 0.0);
+  p2g(grid, p, setup_.scheme, system_node_, first, mass_scatter_, momentum_scatter_);
+  Kokkos::Experimental::contribute(mass_, mass_scatter_);  // no-op for atomic, kept for portability
+  Kokkos::Experimental::contribute(momentum_, momentum_scatter_);
+  mpm_stencils(grid, p, system_node_, stencils_);
+  term_->set_stencils(stencils_);
+  return active_;
+}
+
+template <int dim>
+void MpmBodies<dim>::fill_system(Kokkos::View<double*, MemSpace> x, Kokkos::View<double*, MemSpace> v,
+                                 Kokkos::View<double*, MemSpace> mass) const {
+  const auto grid = setup_.grid;
+  auto gn = grid_node_;
+  auto m = mass_;
+  auto mv = momentum_;
+  const LO first = first_;
+  Kokkos::parallel_for(
+      "mpm_fill_system", Kokkos::RangePolicy<ExecSpace>(0, active_), KOKKOS_LAMBDA(const LO k) {
+        const Vec<dim> xi = grid.node_position(gn(k));
+        const LO s = first + k;
+        for (int c = 0; c < dim; ++c) {
+          x(s * dim + c) = xi(c);
+          v(s * dim + c) = mv(k * dim + c) / m(k);
+          mass(s * dim + c) = m(k);
+        }
+      });
+}
+
+template <int dim>
+void MpmBodies<dim>::end_step(Kokkos::View<const double*, MemSpace> x_new, Kokkos::View<const double*, MemSpace> v_new,
+                              Kokkos::View<const double*, MemSpace> v_old) {
+  g2p(setup_.grid, setup_.particles, setup_.scheme, system_node_, x_new, v_new, v_old);
+}
+
+template <int dim>
+typename MpmBodies<dim>::Diagnostics MpmBodies<dim>::diagnostics(const std::array<double, 3>& g) const {
+  const auto& p = setup_.particles;
+  auto mats = materials_;
+  const bool apic = setup_.scheme == TransferScheme::APIC;
+  const double D = setup_.grid.dx * setup_.grid.dx / 4.0;
+  double ke = 0, el = 0, pe = 0, p0 = 0, p1 = 0, p2 = 0, L = 0;
+  Kokkos::parallel_reduce(
+      "mpm_diagnostics", Kokkos::RangePolicy<ExecSpace>(0, p.size()),
+      KOKKOS_LAMBDA(const LO q, double& k, double& e, double& u, double& q0, double& q1, double& q2, double& l) {
+        const double m = p.mass(q);
+        Mat<dim> F;
+        for (int i = 0; i < dim; ++i)
+          for (int j = 0; j < dim; ++j) F(i, j) = p.F(q, i, j);
+        e += p.volume0(q) * material_energy<dim>(mats(p.material(q)), F);
+        double v2 = 0;
+        for (int c = 0; c < dim; ++c) {
+          v2 += p.v(q, c) * p.v(q, c);
+          u -= m * g[c] * p.x(q, c);
+        }
+        k += 0.5 * m * v2;
+        q0 += m * p.v(q, 0);
+        q1 += m * p.v(q, 1);
+        if constexpr (dim == 3) q2 += m * p.v(q, 2);
+        // z angular momentum: x v_y - y v_x, plus the APIC affine part
+        // m (B^T)_{xy} - m (B^T)_{yx} with B = C D.
+        l += m * (p.x(q, 0) * p.v(q, 1) - p.x(q, 1) * p.v(q, 0));
+        if (apic) l += m * D * (p.C(q, 1, 0) - p.C(q, 0, 1));
+      },
+      ke, el, pe, p0, p1, p2, L);
+  Diagnostics d;
+  d.kinetic = ke;
+  d.elastic = el;
+  d.potential = pe;
+  d.momentum[0] = p0;
+  d.momentum[1] = p1;
+  d.momentum[2] = p2;
+  d.angular = L;
+  return d;
+}
+
+template class MpmElasticityTerm<2>;
+template class MpmElasticityTerm<3>;
+template class MpmBodies<2>;
+template class MpmBodies<3>;
+
+}  // namespace bfemp

@@ -1,0 +1,80 @@
+#pragma once
+// The MPM part of a scene: particles, background grid, transfer scheme, and the
+// per-step grid state that joins the Newton system (active grid nodes numbered
+// after the FEM nodes). One step: begin_step (activation, P2G, stencils),
+// fill_system (grid x^n, v^n, mass), the Newton solve, end_step (G2P).
+#include <Kokkos_ScatterView.hpp>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "kernels/mpm_transfer.hpp"
+#include "solver/energy_term.hpp"
+
+namespace bfemp {
+
+template <int dim>
+struct MpmSetup {
+  GridSpec<dim> grid;
+  Particles<dim> particles;
+  TransferScheme scheme = TransferScheme::APIC;
+  std::vector<std::string> body_names;
+};
+
+// MPM elasticity: deformation stencils of the particles; the graph couplings
+// come from one particle per distinct stencil (particles in a cell share it).
+template <int dim>
+class MpmElasticityTerm : public DeformationTerm<dim, bspline_stencil_size<dim>> {
+ public:
+  using DeformationTerm<dim, bspline_stencil_size<dim>>::DeformationTerm;
+  void add_couplings(std::vector<long long>& keys, LO n_nodes) const override;
+};
+
+template <int dim>
+class MpmBodies {
+ public:
+  static constexpr int ns = bspline_stencil_size<dim>;
+  MpmBodies(MpmSetup<dim> setup, Kokkos::View<MaterialParams*, MemSpace> materials);
+
+  // Activates the grid for this step's particles, P2G, builds the stencils.
+  // Returns the number of active nodes (system nodes first .. first+count-1).
+  // Throws std::runtime_error naming the particle and step when a particle's
+  // stencil leaves the grid domain.
+  LO begin_step(LO first, long step);
+  // Grid x^n (node positions), v^n = (m v)/m, and per-DOF mass into system
+  // vectors at the active nodes.
+  void fill_system(Kokkos::View<double*, MemSpace> x, Kokkos::View<double*, MemSpace> v,
+                   Kokkos::View<double*, MemSpace> mass) const;
+  // G2P from the solved grid positions/velocities (v_old: grid v^n).
+  void end_step(Kokkos::View<const double*, MemSpace> x_new, Kokkos::View<const double*, MemSpace> v_new,
+                Kokkos::View<const double*, MemSpace> v_old);
+
+  const MpmElasticityTerm<dim>& term() const { return *term_; }
+  const Particles<dim>& particles() const { return setup_.particles; }
+  const GridSpec<dim>& grid() const { return setup_.grid; }
+  TransferScheme scheme() const { return setup_.scheme; }
+  LO active_nodes() const { return active_; }
+
+  // Particle diagnostics: kinetic, elastic (sum V0 psi(F_p)), gravity potential,
+  // linear momentum, angular momentum about the origin (z; APIC adds the
+  // affine part m_p (B_p)^T term).
+  struct Diagnostics { double kinetic = 0, elastic = 0, potential = 0; double momentum[3] = {0, 0, 0}; double angular = 0; };
+  Diagnostics diagnostics(const std::array<double, 3>& gravity) const;
+
+ private:
+  MpmSetup<dim> setup_;
+  Kokkos::View<MaterialParams*, MemSpace> materials_;
+  Kokkos::View<LO*, MemSpace> system_node_;  // per grid node
+  Kokkos::View<LO*, MemSpace> grid_node_;    // per active node
+  Kokkos::View<double*, MemSpace> mass_, momentum_;  // per active node (capacity grows)
+  using Scatter = Kokkos::Experimental::ScatterView<double*, Kokkos::LayoutRight, ExecSpace,
+                                                    Kokkos::Experimental::ScatterSum,
+                                                    Kokkos::Experimental::ScatterNonDuplicated,
+                                                    Kokkos::Experimental::ScatterAtomic>;
+  Scatter mass_scatter_, momentum_scatter_;
+  DeformationStencils<dim, ns> stencils_;
+  std::unique_ptr<MpmElasticityTerm<dim>> term_;
+  LO first_ = 0, active_ = 0;
+};
+
+}  // namespace bfemp

@@ -1,0 +1,286 @@
+#include "sim/simulation.hpp"
+
+#include <Kokkos_Timer.hpp>
+#include <sstream>
+
+#include "solver/solver_error.hpp"
+
+namespace bfemp {
+
+using View1 = Kokkos::View<double*, MemSpace>;
+
+// System vectors over FEM nodes + active grid nodes; capacity grows, never
+// shrinks, so steps do not reallocate.
+template <int dim>
+struct Simulation<dim>::System {
+  View1 x, v, v_old, a, x_hat, target, mass, work;
+  Kokkos::View<int*, MemSpace> prescribed;
+  std::size_t n = 0;
+  void resize(std::size_t nd) {
+    n = nd;
+    if (x.extent(0) >= nd) return;
+    const std::size_t cap = nd + nd / 4;
+    for (View1* w : {&x, &v, &v_old, &a, &x_hat, &target, &mass, &work}) *w = View1(w->label(), cap);
+    prescribed = Kokkos::View<int*, MemSpace>("sys_prescribed", cap);
+  }
+  template <class V>
+  static auto head(const V& view, std::size_t n) { return Kokkos::subview(view, std::make_pair(std::size_t(0), n)); }
+};
+
+template <int dim>
+Simulation<dim>::Simulation(SimulationSetup<dim> setup, const Teuchos::RCP<const Comm>& comm)
+    : setup_(std::move(setup)), mesh_(build_fem_mesh<dim>(setup_.bodies, setup_.materials)) {
+  if (!(setup_.dt > 0))
+    throw std::invalid_argument("time step dt = " + std::to_string(setup_.dt) + ": expected dt > 0");
+  elasticity_ = std::make_unique<DeformationTerm<dim, dim + 1>>("fem elasticity", mesh_.elements);
+  if (setup_.mpm) mpm_ = std::make_unique<MpmBodies<dim>>(*setup_.mpm, mesh_.elements.materials);
+  newton_ = std::make_unique<NewtonSolver<dim>>(comm, setup_.linear_solver, setup_.newton);
+  sys_ = std::make_unique<System>();
+  if (!mpm_) newton_->set_system(mesh_.num_nodes(), {elasticity_.get()}, true);
+  const std::size_t n = static_cast<std::size_t>(mesh_.num_nodes()) * dim;
+  x_ = View1("fem_x", n);
+  v_ = View1("fem_v", n);
+  a_ = View1("fem_a", n);
+  mass_ = View1("fem_mass_dof", n);
+  initial_position_ = View1("fem_x0", n);
+  prescribed_ = Kokkos::View<int*, MemSpace>("fem_prescribed", n);
+  Kokkos::deep_copy(x_, mesh_.rest_position);
+  Kokkos::deep_copy(initial_position_, mesh_.rest_position);
+  auto nm = mesh_.node_mass;
+  auto md = mass_;
+  Kokkos::parallel_for(
+      "fem_mass_dof", Kokkos::RangePolicy<ExecSpace>(0, n), KOKKOS_LAMBDA(const LO i) { md(i) = nm(i / dim); });
+
+  auto v = Kokkos::create_mirror_view(v_);
+  Kokkos::deep_copy(v, 0.0);
+  for (std::size_t b = 0; b < mesh_.bodies.size() && b < setup_.initial_velocity.size(); ++b) {
+    const auto& r = mesh_.bodies[b];
+    for (LO i = r.first_node; i < r.first_node + r.num_nodes; ++i)
+      for (int c = 0; c < dim; ++c) v(i * dim + c) = setup_.initial_velocity[b][c];
+  }
+  auto pres = Kokkos::create_mirror_view(prescribed_);
+  Kokkos::deep_copy(pres, 0);
+  auto X0 = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), initial_position_);
+  for (const auto& mo : setup_.motions)
+    for (LO node : mo.nodes) {
+      if (node < 0 || node >= mesh_.num_nodes())
+        throw std::invalid_argument("prescribed motion '" + mo.name + "': node " +
+                                    std::to_string(node) + " out of range");
+      Vec<dim> X;
+      for (int c = 0; c < dim; ++c) X(c) = X0(node * dim + c);
+      const Vec<dim> vel = mo.template velocity<dim>(X, 0.0);
+      for (int c = 0; c < dim; ++c) {
+        pres(node * dim + c) = 1;
+        v(node * dim + c) = vel(c);
+      }
+    }
+  Kokkos::deep_copy(v_, v);
+  Kokkos::deep_copy(prescribed_, pres);
+  reset_acceleration();
+}
+
+template <int dim>
+Simulation<dim>::~Simulation() = default;
+
+template <int dim>
+void Simulation<dim>::reset_acceleration() {
+  auto a = a_;
+  auto m = mass_;
+  auto pres = prescribed_;
+  Kokkos::deep_copy(a, 0.0);
+  newton_->potential_gradient(x_, -1.0, a);
+  const auto g = setup_.gravity;
+  Kokkos::parallel_for(
+      "fem_a0", Kokkos::RangePolicy<ExecSpace>(0, a.extent(0)), KOKKOS_LAMBDA(const LO i) {
+        a(i) = pres(i) ? 0.0 : a(i) / m(i) + g[i % dim];
+      });
+}
+
+template <int dim>
+void Simulation<dim>::apply_prescribed_targets(double t, View1 target) const {
+  auto tgt = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), target);
+  auto X0 = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), initial_position_);
+  for (const auto& mo : setup_.motions)
+    for (LO node : mo.nodes) {
+      Vec<dim> X;
+      for (int c = 0; c < dim; ++c) X(c) = X0(node * dim + c);
+      const Vec<dim> p = mo.template position<dim>(X, t);
+      for (int c = 0; c < dim; ++c) tgt(node * dim + c) = p(c);
+    }
+  Kokkos::deep_copy(target, tgt);
+}
+
+template <int dim>
+void Simulation<dim>::prescribed_velocities(double t1) {
+  if (setup_.motions.empty()) return;
+  const double dt = setup_.dt;
+  auto vh = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), v_);
+  auto ah = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), a_);
+  auto X0 = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), initial_position_);
+  for (const auto& mo : setup_.motions)
+    for (LO node : mo.nodes) {
+      Vec<dim> X;
+      for (int c = 0; c < dim; ++c) X(c) = X0(node * dim + c);
+      const Vec<dim> vel = mo.template velocity<dim>(X, t1);
+      for (int c = 0; c < dim; ++c) {
+        ah(node * dim + c) = (vel(c) - vh(node * dim + c)) / dt;
+        vh(node * dim + c) = vel(c);
+      }
+    }
+  Kokkos::deep_copy(v_, vh);
+  Kokkos::deep_copy(a_, ah);
+}
+
+template <int dim>
+StepReport Simulation<dim>::step() {
+  Kokkos::Timer timer;
+  const double dt = setup_.dt;
+  const double t1 = time_ + dt;
+  const TimeIntegrator& ti = setup_.integrator;
+  const double h = ti.potential_scale(dt);
+  const double ca = ti.predictor_acc_scale(dt);
+  const auto g = setup_.gravity;
+  const LO nF = mesh_.num_nodes();
+  const LO nA = mpm_ ? mpm_->begin_step(nF, step_ + 1) : 0;
+  const std::size_t nfd = static_cast<std::size_t>(nF) * dim;
+  const std::size_t nd = nfd + static_cast<std::size_t>(nA) * dim;
+  System& S = *sys_;
+  S.resize(nd);
+  auto x = System::head(S.x, nd);
+  auto v = System::head(S.v, nd);
+  auto v_old = System::head(S.v_old, nd);
+  auto a = System::head(S.a, nd);
+  auto xhat = System::head(S.x_hat, nd);
+  auto target = System::head(S.target, nd);
+  auto mass = System::head(S.mass, nd);
+  auto pres = System::head(S.prescribed, nd);
+  auto fem = std::make_pair(std::size_t(0), nfd);
+  Kokkos::deep_copy(Kokkos::subview(x, fem), x_);
+  Kokkos::deep_copy(Kokkos::subview(v, fem), v_);
+  Kokkos::deep_copy(Kokkos::subview(a, fem), a_);
+  Kokkos::deep_copy(Kokkos::subview(mass, fem), mass_);
+  Kokkos::deep_copy(Kokkos::subview(pres, fem), prescribed_);
+  std::vector<const EnergyTerm<dim>*> terms;
+  if (nF > 0) terms.push_back(elasticity_.get());
+  if (mpm_) {
+    auto grid_part = std::make_pair(nfd, nd);
+    Kokkos::deep_copy(Kokkos::subview(pres, grid_part), 0);
+    mpm_->fill_system(x, v, mass);
+    terms.push_back(&mpm_->term());
+    newton_->set_system(nF + nA, terms, true);
+    // Grid a^n = g - M^-1 grad Psi(x^n) (the Newmark predictor needs it).
+    auto work = System::head(S.work, nd);
+    Kokkos::deep_copy(work, 0.0);
+    newton_->potential_gradient(x, -1.0, work);
+    const std::size_t off = nfd;
+    Kokkos::parallel_for(
+        "grid_a0", Kokkos::RangePolicy<ExecSpace>(off, nd),
+        KOKKOS_LAMBDA(const std::size_t i) { a(i) = work(i) / mass(i) + g[i % dim]; });
+    Kokkos::deep_copy(v_old, v);
+  }
+  Kokkos::parallel_for(
+      "predictor", Kokkos::RangePolicy<ExecSpace>(0, nd), KOKKOS_LAMBDA(const std::size_t i) {
+        xhat(i) = x(i) + dt * v(i) + ca * a(i) + h * g[i % dim];
+      });
+  if (!setup_.motions.empty()) apply_prescribed_targets(t1, target);
+
+  IncrementalPotential ip{xhat, mass, pres, target, h, dt};
+  NewtonStats ns;
+  try {
+    ns = newton_->minimize(ip, x);
+  } catch (const SolverError& e) {
+    std::ostringstream msg;
+    msg << "step " << step_ + 1 << " (t = " << t1 << " s): " << e.what();
+    throw SolverError(msg.str());
+  }
+
+  const double gamma = ti.gamma;
+  Kokkos::parallel_for(
+      "velocity_update", Kokkos::RangePolicy<ExecSpace>(0, nd), KOKKOS_LAMBDA(const std::size_t i) {
+        if (pres(i)) return;
+        const double a1 = (x(i) - xhat(i)) / h + g[i % dim];
+        v(i) += dt * ((1.0 - gamma) * a(i) + gamma * a1);
+        a(i) = a1;
+      });
+  Kokkos::deep_copy(x_, Kokkos::subview(x, fem));
+  Kokkos::deep_copy(v_, Kokkos::subview(v, fem));
+  Kokkos::deep_copy(a_, Kokkos::subview(a, fem));
+  prescribed_velocities(t1);
+  if (mpm_) mpm_->end_step(x, v, v_old);
+  time_ = t1;
+  ++step_;
+  StepReport r = diagnostics();
+  r.newton = ns;
+  r.active_grid_nodes = nA;
+  r.step_s = timer.seconds();
+  return r;
+}
+
+template <int dim>
+StepReport Simulation<dim>::diagnostics() const {
+  StepReport r;
+  r.step = step_;
+  r.time = time_;
+  r.dt = setup_.dt;
+  auto x = x_;
+  auto v = v_;
+  auto m = mass_;
+  const auto g = setup_.gravity;
+  struct Sums { double ke, pe, p[3]; };
+  double ke = 0, pe = 0, p0 = 0, p1 = 0, p2 = 0;
+  Kokkos::parallel_reduce(
+      "fem_energy_momentum", Kokkos::RangePolicy<ExecSpace>(0, x.extent(0)),
+      KOKKOS_LAMBDA(const LO i, double& k, double& u, double& q0, double& q1, double& q2) {
+        const int c = i % dim;
+        k += 0.5 * m(i) * v(i) * v(i);
+        u -= m(i) * g[c] * x(i);
+        const double pi = m(i) * v(i);
+        if (c == 0) q0 += pi;
+        if (c == 1) q1 += pi;
+        if (c == 2) q2 += pi;
+      },
+      ke, pe, p0, p1, p2);
+  r.kinetic = ke;
+  r.potential = pe;
+  r.momentum = {p0, p1, p2};
+  r.elastic = deformation_energy(mesh_.elements, x_);
+  r.min_J = mesh_.num_cells() > 0 ? deformation_min_J(mesh_.elements, x_) : 1.0;
+  {
+    auto X = x_;
+    double L = 0;
+    Kokkos::parallel_reduce(
+        "fem_angular_momentum", Kokkos::RangePolicy<ExecSpace>(0, mesh_.num_nodes()),
+        KOKKOS_LAMBDA(const LO n, double& l) {
+          l += m(n * dim) * (X(n * dim) * v(n * dim + 1) - X(n * dim + 1) * v(n * dim));
+        },
+        L);
+    r.angular_momentum_z = L;
+  }
+  if (mpm_) {
+    const auto d = mpm_->diagnostics(setup_.gravity);
+    r.kinetic += d.kinetic;
+    r.elastic += d.elastic;
+    r.potential += d.potential;
+    for (int c = 0; c < 3; ++c) r.momentum[c] += d.momentum[c];
+    r.angular_momentum_z += d.angular;
+    r.min_J = std::min(r.min_J, mpm_particle_min_J(mpm_->particles()));
+    r.active_grid_nodes = mpm_->active_nodes();
+  }
+  return r;
+}
+
+template <int dim>
+void Simulation<dim>::element_J(View1 J) const {
+  deformation_J_von_mises(mesh_.elements, x_, J, View1());
+}
+
+template <int dim>
+void Simulation<dim>::element_von_mises(View1 s) const {
+  View1 J("fem_J_tmp", mesh_.num_cells());
+  deformation_J_von_mises(mesh_.elements, x_, J, s);
+}
+
+template class Simulation<2>;
+template class Simulation<3>;
+
+}  // namespace bfemp
