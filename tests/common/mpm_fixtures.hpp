@@ -1,0 +1,47 @@
+#pragma once
+// Small MPM set-ups shared by the scene tests.
+#include "common/fem_fixtures.hpp"
+#include "mpm/sampling.hpp"
+
+namespace bfemp::fixtures {
+
+// A square block of MPM particles (side `side`, centred at `center`), on a
+// grid of spacing dx covering [lo, hi]^2.
+inline SimulationSetup<2> mpm_block_setup(double side, Vec<2> center, double dx, int ppc, double lo, double hi,
+                                          TransferScheme scheme, double E = 1e6, double nu = 0.3,
+                                          double rho = 1000.0) {
+  SimulationSetup<2> s;
+  MaterialParams mp;
+  mp.model = MaterialModel::NeoHookean;
+  mp.lame = lame_from_young(E, nu);
+  mp.density = rho;
+  s.materials.push_back(mp);
+  SamplingShape shape;
+  shape.kind = "box";
+  shape.center = {center(0), center(1)};
+  shape.size = {side, side};
+  MpmSetup<2> m;
+  m.particles = sample_particles<2>(shape, dx, ppc, rho, 0, 0);
+  m.grid = grid_covering<2>(Vec<2>(lo, lo), Vec<2>(hi, hi), dx);
+  m.scheme = scheme;
+  m.body_names = {"block"};
+  s.mpm = m;
+  s.linear_solver = *linear_solver_schema();
+  s.newton.eps_d = 1e-9;
+  return s;
+}
+
+// Mass-weighted mean of particle coordinate c.
+template <int dim>
+double particle_mean(const Particles<dim>& p, int c) {
+  auto x = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), p.x);
+  auto m = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), p.mass);
+  double sm = 0, sx = 0;
+  for (std::size_t q = 0; q < m.extent(0); ++q) {
+    sm += m(q);
+    sx += m(q) * x(q, c);
+  }
+  return sx / sm;
+}
+
+}  // namespace bfemp::fixtures
