@@ -229,10 +229,10 @@ struct DetPolynomial {
 //   0          if T or dT are not finite, or det T is not positive beyond
 //              rounding (already inverted or degenerate);
 //   otherwise  alpha* <= the smallest positive root, where det(T + alpha* dT)
-//              is still certified positive: a few ulps below a simple root
-//              (relative u times its condition number), and for a double or
-//              triple root the start of the band where det is zero within
-//              rounding (about sqrt(u) resp. cbrt(u) relative, worst case).
+//              is still certified positive: below a simple root by about u
+//              times its condition number; at a double/triple root, the start
+//              of the band where det is zero within rounding (generic data:
+//              up to ~sqrt(u) relative for a double root).
 template <int dim>
 KOKKOS_INLINE_FUNCTION double smallest_positive_det_root(const Mat<dim>& T, const Mat<dim>& dT) {
   constexpr double inf = std::numeric_limits<double>::infinity();

@@ -36,6 +36,10 @@ Simulation<dim>::Simulation(SimulationSetup<dim> setup, const Teuchos::RCP<const
   if (setup_.mpm) mpm_ = std::make_unique<MpmBodies<dim>>(*setup_.mpm, mesh_.elements.materials);
   newton_ = std::make_unique<NewtonSolver<dim>>(comm, setup_.linear_solver, setup_.newton);
   sys_ = std::make_unique<System>();
+  if (setup_.level_sets.size() > static_cast<std::size_t>(kMaxLevelSets))
+    throw std::invalid_argument("scene has " + std::to_string(setup_.level_sets.size()) +
+                                " level sets; expected at most " + std::to_string(kMaxLevelSets));
+  for (const auto& ls : setup_.level_sets) level_sets_.sets[level_sets_.count++] = ls;
   if (!mpm_) newton_->set_system(mesh_.num_nodes(), {elasticity_.get()}, true);
   const std::size_t n = static_cast<std::size_t>(mesh_.num_nodes()) * dim;
   x_ = View1("fem_x", n);
@@ -166,6 +170,7 @@ StepReport Simulation<dim>::step() {
     auto grid_part = std::make_pair(nfd, nd);
     Kokkos::deep_copy(Kokkos::subview(pres, grid_part), 0);
     mpm_->fill_system(x, v, mass);
+    apply_level_sets<dim>(level_sets_, time_, dt, nfd, nd, x, v, target, pres);
     terms.push_back(&mpm_->term());
     newton_->set_system(nF + nA, terms, true);
     // Grid a^n = g - M^-1 grad Psi(x^n) (the Newmark predictor needs it).

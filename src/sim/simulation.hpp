@@ -12,6 +12,7 @@
 
 #include "fem/fem_mesh.hpp"
 #include "fem/prescribed_motion.hpp"
+#include "mpm/level_set.hpp"
 #include "mpm/mpm_bodies.hpp"
 #include "solver/newton.hpp"
 #include "time/integrator.hpp"
@@ -25,6 +26,7 @@ struct SimulationSetup {
   std::vector<std::array<double, 3>> initial_velocity;  // per FEM body (empty: at rest)
   std::vector<PrescribedMotion> motions;                // node ids are global FEM ids
   std::optional<MpmSetup<dim>> mpm;                     // MPM particles and grid
+  std::vector<LevelSet> level_sets;                     // grid boundaries (MPM)
   TimeIntegrator integrator = TimeIntegrator::backward_euler();
   std::array<double, 3> gravity{0, 0, 0};
   double dt = 1e-3;
@@ -80,6 +82,7 @@ class Simulation {
   std::unique_ptr<MpmBodies<dim>> mpm_;
   std::unique_ptr<NewtonSolver<dim>> newton_;
   std::unique_ptr<System> sys_;
+  LevelSetList level_sets_;
   Kokkos::View<double*, MemSpace> x_, v_, a_, mass_, initial_position_;
   Kokkos::View<int*, MemSpace> prescribed_;
   double time_ = 0;

@@ -5,11 +5,11 @@
 
 namespace bfemp::fixtures {
 
-// A square block of MPM particles (side `side`, centred at `center`), on a
-// grid of spacing dx covering [lo, hi]^2.
-inline SimulationSetup<2> mpm_block_setup(double side, Vec<2> center, double dx, int ppc, double lo, double hi,
-                                          TransferScheme scheme, double E = 1e6, double nu = 0.3,
-                                          double rho = 1000.0) {
+// A rectangular block of MPM particles (size w x h, centred at `center`) on a
+// grid of spacing dx covering [lo, hi].
+inline SimulationSetup<2> mpm_rect_setup(double w, double h, Vec<2> center, double dx, int ppc, Vec<2> lo,
+                                         Vec<2> hi, TransferScheme scheme, double E = 1e6, double nu = 0.3,
+                                         double rho = 1000.0) {
   SimulationSetup<2> s;
   MaterialParams mp;
   mp.model = MaterialModel::NeoHookean;
@@ -19,16 +19,23 @@ inline SimulationSetup<2> mpm_block_setup(double side, Vec<2> center, double dx,
   SamplingShape shape;
   shape.kind = "box";
   shape.center = {center(0), center(1)};
-  shape.size = {side, side};
+  shape.size = {w, h};
   MpmSetup<2> m;
   m.particles = sample_particles<2>(shape, dx, ppc, rho, 0, 0);
-  m.grid = grid_covering<2>(Vec<2>(lo, lo), Vec<2>(hi, hi), dx);
+  m.grid = grid_covering<2>(lo, hi, dx);
   m.scheme = scheme;
   m.body_names = {"block"};
   s.mpm = m;
   s.linear_solver = *linear_solver_schema();
   s.newton.eps_d = 1e-9;
   return s;
+}
+
+// A square block (side `side`) on a grid covering [lo, hi]^2.
+inline SimulationSetup<2> mpm_block_setup(double side, Vec<2> center, double dx, int ppc, double lo, double hi,
+                                          TransferScheme scheme, double E = 1e6, double nu = 0.3,
+                                          double rho = 1000.0) {
+  return mpm_rect_setup(side, side, center, dx, ppc, Vec<2>(lo, lo), Vec<2>(hi, hi), scheme, E, nu, rho);
 }
 
 // Mass-weighted mean of particle coordinate c.

@@ -1,0 +1,61 @@
+// A tall elastic column (H = 4 W, nu = 0, small strain) settling under gravity
+// on a no-slip level-set ground with backward Euler: the kinetic energy decays
+// by six orders, no particle passes the ground, and the drop of the centre of
+// mass matches rho g H^2 / (3 E) within 5 %, improving as dx is refined.
+#include <gtest/gtest.h>
+
+#include "common/mpm_fixtures.hpp"
+
+using namespace bfemp;
+using namespace bfemp::fixtures;
+
+namespace {
+
+constexpr double W = 0.25, H = 1.0, rho = 1000.0, g = 10.0, E = 1e6;
+
+struct Settled { double drop, ke_ratio, min_y; int steps; };
+
+Settled settle(double dx) {
+  auto s = mpm_rect_setup(W, H, Vec<2>(0.0, H / 2), dx, 4, Vec<2>(-0.5, -0.25), Vec<2>(0.5, 1.25),
+                          TransferScheme::APIC, E, 0.0, rho);
+  s.gravity = {0.0, -g, 0.0};
+  s.integrator = TimeIntegrator::backward_euler();
+  s.dt = 0.02;
+  s.newton.eps_d = 1e-10;
+  LevelSet ground;
+  ground.name = "ground";
+  ground.kind = LevelSetKind::HalfPlane;
+  ground.point = {0.0, 0.0, 0.0};
+  ground.normal = {0.0, 1.0, 0.0};
+  s.level_sets.push_back(ground);
+  Simulation<2> sim(s, fixtures::comm());
+  const double y0 = particle_mean(sim.mpm()->particles(), 1);
+  double ke_max = 0, ke = 0, min_y = 1e300;
+  int k = 0;
+  for (; k < 400; ++k) {
+    ke = sim.step().kinetic;
+    ke_max = std::max(ke_max, ke);
+    auto x = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), sim.mpm()->particles().x);
+    for (std::size_t q = 0; q < x.extent(0); ++q) min_y = std::min(min_y, x(q, 1));
+    if (k > 10 && ke < 1e-7 * ke_max) break;
+  }
+  return {y0 - particle_mean(sim.mpm()->particles(), 1), ke / ke_max, min_y, k + 1};
+}
+
+}  // namespace
+
+TEST(MpmColumn, SettlesToTheAnalyticSelfWeightCompression) {
+  const double exact = rho * g * H * H / (3 * E);
+  const Settled coarse = settle(0.05);
+  const Settled fine = settle(0.025);
+  for (const auto& r : {coarse, fine}) {
+    EXPECT_LT(r.ke_ratio, 1e-6) << "kinetic energy must decay by six orders";
+    EXPECT_GT(r.min_y, 0.0) << "a particle passed the ground";
+  }
+  const double err_c = std::abs(coarse.drop - exact) / exact, err_f = std::abs(fine.drop - exact) / exact;
+  EXPECT_LT(err_f, 0.05);
+  EXPECT_LT(err_f, err_c) << "the error must fall as dx is refined";
+  std::cout << "column drop: exact " << exact << ", dx 0.05: " << coarse.drop << " (" << err_c * 100
+            << " %, " << coarse.steps << " steps), dx 0.025: " << fine.drop << " (" << err_f * 100 << " %, "
+            << fine.steps << " steps)\n";
+}
