@@ -143,6 +143,18 @@ double deformation_max_step(const DeformationStencils<dim, nv>& s, Kokkos::View<
   return amin;
 }
 
+// Von Mises stress of the Cauchy stress of F (2D: in-plane components).
+template <int dim>
+KOKKOS_INLINE_FUNCTION double von_mises_of(const MaterialParams& mp, const Mat<dim>& F) {
+  const Mat<dim> sg = material_first_piola<dim>(mp, F) * F.transpose() / F.determinant();
+  if constexpr (dim == 2) {
+    return std::sqrt(sg(0, 0) * sg(0, 0) - sg(0, 0) * sg(1, 1) + sg(1, 1) * sg(1, 1) + 3 * sg(0, 1) * sg(0, 1));
+  } else {
+    const Mat<dim> dev = sg - sg.trace() / 3.0 * Mat<dim>::Identity();
+    return std::sqrt(1.5 * dev.squaredNorm());
+  }
+}
+
 // J = det F_q and the von Mises stress of sigma = P F^T / J (2D: in-plane
 // components, sqrt(sxx^2 - sxx syy + syy^2 + 3 sxy^2)).
 template <int dim, int nv>
@@ -151,17 +163,8 @@ void deformation_J_von_mises(const DeformationStencils<dim, nv>& s, Kokkos::View
   Kokkos::parallel_for(
       "deformation_J_von_mises", Kokkos::RangePolicy<ExecSpace>(0, s.size()), KOKKOS_LAMBDA(const LO q) {
         const Mat<dim> F = stencil_F(s, x, q);
-        const double det = F.determinant();
-        J(q) = det;
-        if (von_mises.extent(0) == 0) return;
-        const Mat<dim> sg = material_first_piola<dim>(s.materials(s.material(q)), F) * F.transpose() / det;
-        if constexpr (dim == 2) {
-          von_mises(q) = std::sqrt(sg(0, 0) * sg(0, 0) - sg(0, 0) * sg(1, 1) + sg(1, 1) * sg(1, 1) +
-                                   3 * sg(0, 1) * sg(0, 1));
-        } else {
-          const Mat<dim> dev = sg - sg.trace() / 3.0 * Mat<dim>::Identity();
-          von_mises(q) = std::sqrt(1.5 * dev.squaredNorm());
-        }
+        J(q) = F.determinant();
+        if (von_mises.extent(0) > 0) von_mises(q) = von_mises_of<dim>(s.materials(s.material(q)), F);
       });
 }
 

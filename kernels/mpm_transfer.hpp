@@ -176,6 +176,20 @@ void g2p(const GridSpec<dim>& grid, const Particles<dim>& p, TransferScheme sche
       });
 }
 
+// Per-particle J = det F_p and von Mises stress.
+template <int dim>
+void mpm_particle_J_von_mises(const Particles<dim>& p, Kokkos::View<const MaterialParams*, MemSpace> mats,
+                              Kokkos::View<double*, MemSpace> J, Kokkos::View<double*, MemSpace> vm) {
+  Kokkos::parallel_for(
+      "mpm_J_von_mises", Kokkos::RangePolicy<ExecSpace>(0, p.size()), KOKKOS_LAMBDA(const LO q) {
+        Mat<dim> F;
+        for (int i = 0; i < dim; ++i)
+          for (int j = 0; j < dim; ++j) F(i, j) = p.F(q, i, j);
+        J(q) = F.determinant();
+        vm(q) = von_mises_of<dim>(mats(p.material(q)), F);
+      });
+}
+
 // Smallest det F_p over the particles (1 when there are none).
 template <int dim>
 double mpm_particle_min_J(const Particles<dim>& p) {

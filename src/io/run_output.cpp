@@ -12,7 +12,7 @@ const std::vector<std::string>& diagnostics_columns() {
   static const std::vector<std::string> cols = {
       "step", "time", "dt", "kinetic", "elastic", "potential", "total_energy", "momentum_x",
       "momentum_y", "momentum_z", "newton_iters", "linear_iters", "min_J", "assembly_s", "solve_s",
-      "step_s"};
+      "step_s", "active_grid_nodes"};
   return cols;
 }
 
@@ -20,7 +20,7 @@ std::vector<double> diagnostics_row(const StepReport& r) {
   return {static_cast<double>(r.step), r.time, r.dt, r.kinetic, r.elastic, r.potential,
           r.total_energy(), r.momentum[0], r.momentum[1], r.momentum[2],
           static_cast<double>(r.newton.iterations), static_cast<double>(r.newton.linear_iterations),
-          r.min_J, r.newton.assembly_s, r.newton.solve_s, r.step_s};
+          r.min_J, r.newton.assembly_s, r.newton.solve_s, r.step_s, static_cast<double>(r.active_grid_nodes)};
 }
 
 namespace {
@@ -35,7 +35,7 @@ RunOutput<dim>::RunOutput(const std::string& dir, const Scene& scene, const Simu
     : dir_(prepare_dir(dir)),
       h5_(dir + "/bfemp.h5"),
       xdmf_(dir + "/bfemp.xdmf", "bfemp.h5"),
-      csv_(dir + "/diagnostics.csv", diagnostics_columns(), {"step", "newton_iters", "linear_iters"}) {
+      csv_(dir + "/diagnostics.csv", diagnostics_columns(), {"step", "newton_iters", "linear_iters", "active_grid_nodes"}) {
   std::ostringstream yaml;
   yaml << std::showpoint;
   Teuchos::writeParameterListToYamlOStream(scene.params, yaml);
@@ -44,7 +44,7 @@ RunOutput<dim>::RunOutput(const std::string& dir, const Scene& scene, const Simu
   std::vector<long long> conn(cells.size());
   for (std::size_t e = 0; e < cells.extent(0); ++e)
     for (int a = 0; a <= dim; ++a) conn[e * (dim + 1) + a] = cells(e, a);
-  h5_.write_static("cells", conn.data(), cells.extent(0), dim + 1);
+  if (!conn.empty()) h5_.write_static("cells", conn.data(), cells.extent(0), dim + 1);
 }
 
 template <int dim>
@@ -59,20 +59,53 @@ void RunOutput<dim>::write_frame(const Simulation<dim>& sim) {
   auto Jh = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), J);
   auto vmh = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), vm);
   h5_.begin_frame(frame_, sim.time(), sim.step_index());
-  h5_.write_array("positions", x.data(), nn, dim);
-  h5_.write_array("velocities", v.data(), nn, dim);
-  h5_.write_array("von_mises", vmh.data(), ne, 1);
-  h5_.write_array("J", Jh.data(), ne, 1);
+  XdmfFrame frame{sim.time(), {}};
+  if (nn > 0) {
+    h5_.write_array("positions", x.data(), nn, dim);
+    h5_.write_array("velocities", v.data(), nn, dim);
+    h5_.write_array("von_mises", vmh.data(), ne, 1);
+    h5_.write_array("J", Jh.data(), ne, 1);
+    XdmfGrid g;
+    g.name = "fem";
+    g.group = Hdf5FrameWriter::frame_group_name(frame_);
+    g.topology = {dim == 2 ? "Triangle" : "Tetrahedron", ne, dim + 1, "/mesh/cells"};
+    g.num_nodes = nn;
+    g.dim = dim;
+    g.node_attributes = {{"velocity", "velocities", dim}};
+    g.cell_attributes = {{"von_mises", "von_mises", 1}, {"J", "J", 1}};
+    frame.grids.push_back(g);
+  }
+  if (const auto* mpm = sim.mpm()) {
+    const auto& p = mpm->particles();
+    const std::size_t np = p.size();
+    Kokkos::View<double*, MemSpace> pJ("frame_particle_J", np), pvm("frame_particle_vm", np);
+    mpm_particle_J_von_mises<dim>(p, sim.mesh().elements.materials, pJ, pvm);
+    auto px = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), p.x);
+    auto pv = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), p.v);
+    auto pb = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), p.body);
+    auto pJh = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), pJ);
+    auto pvmh = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), pvm);
+    std::vector<long long> body(pb.data(), pb.data() + np);
+    h5_.write_array("particle_positions", px.data(), np, dim);
+    h5_.write_array("particle_velocities", pv.data(), np, dim);
+    h5_.write_array("particle_von_mises", pvmh.data(), np, 1);
+    h5_.write_array("particle_J", pJh.data(), np, 1);
+    h5_.write_array("particle_body", body.data(), np, 1);
+    XdmfGrid g;
+    g.name = "particles";
+    g.group = Hdf5FrameWriter::frame_group_name(frame_);
+    g.topology = {"Polyvertex", np, 1, ""};
+    g.num_nodes = np;
+    g.dim = dim;
+    g.geometry = "particle_positions";
+    g.node_attributes = {{"velocity", "particle_velocities", dim},
+                         {"von_mises", "particle_von_mises", 1},
+                         {"J", "particle_J", 1},
+                         {"body", "particle_body", 1, true}};
+    frame.grids.push_back(g);
+  }
   h5_.end_frame();
-  XdmfGrid g;
-  g.name = "fem";
-  g.group = Hdf5FrameWriter::frame_group_name(frame_);
-  g.topology = {dim == 2 ? "Triangle" : "Tetrahedron", ne, dim + 1, "/mesh/cells"};
-  g.num_nodes = nn;
-  g.dim = dim;
-  g.node_attributes = {{"velocity", "velocities", dim}};
-  g.cell_attributes = {{"von_mises", "von_mises", 1}, {"J", "J", 1}};
-  xdmf_.add_frame(XdmfFrame{sim.time(), {g}});
+  xdmf_.add_frame(frame);
   ++frame_;
 }
 

@@ -9,6 +9,7 @@
 #include "io/gmsh_reader.hpp"
 #include "io/scene_validate.hpp"
 #include "io/shape_mesher.hpp"
+#include "mpm/sampling.hpp"
 
 namespace bfemp {
 
@@ -63,13 +64,28 @@ Scene finish(ParameterList raw, const std::string& path, const std::string& base
     if (!(nu > -1 && nu < 0.5)) bad(k + "nu", num(nu), "a Poisson ratio in (-1, 0.5)");
     if (!(m.get<double>("density") > 0)) bad(k + "density", num(m.get<double>("density")), "density > 0");
   }
-  const auto& bodies = raw.sublist("FEM Bodies");
-  if (bodies.numParams() == 0) bad("FEM Bodies", "{}", "at least one body");
-  for (auto it = bodies.begin(); it != bodies.end(); ++it) {
-    const auto& b = bodies.sublist(bodies.name(it));
-    const std::string mname = b.get<std::string>("material");
-    if (!mats.isSublist(mname))
-      bad("FEM Bodies/" + bodies.name(it) + "/material", "'" + mname + "'", "the name of an entry of Materials");
+  const auto& mpm_bodies = raw.sublist("MPM Bodies");
+  if (raw.sublist("FEM Bodies").numParams() + mpm_bodies.numParams() == 0)
+    bad("FEM Bodies", "{}", "at least one FEM or MPM body");
+  for (const char* container : {"FEM Bodies", "MPM Bodies"}) {
+    const auto& bodies = raw.sublist(container);
+    for (auto it = bodies.begin(); it != bodies.end(); ++it) {
+      const std::string mname = bodies.sublist(bodies.name(it)).get<std::string>("material");
+      if (!mats.isSublist(mname))
+        bad(std::string(container) + "/" + bodies.name(it) + "/material", "'" + mname + "'",
+            "the name of an entry of Materials");
+    }
+  }
+  if (mpm_bodies.numParams() > 0) {
+    const auto& m = raw.sublist("MPM");
+    if (!(m.get<double>("grid spacing") > 0)) bad("MPM/grid spacing", num(m.get<double>("grid spacing")), "dx > 0 (m)");
+    for (const char* k : {"domain min", "domain max"}) {
+      const auto a = m.get<Array<double>>(k);
+      if (static_cast<int>(a.size()) != dim) bad(std::string("MPM/") + k, Teuchos::toString(a), std::to_string(dim) + " components");
+    }
+    const int ppc = m.get<int>("particles per cell");
+    const bool ok = dim == 2 ? (ppc == 1 || ppc == 4 || ppc == 9 || ppc == 16) : (ppc == 1 || ppc == 8 || ppc == 27);
+    if (!ok) bad("MPM/particles per cell", std::to_string(ppc), dim == 2 ? "1, 4, 9 or 16" : "1, 8 or 27");
   }
   return s;
 }
@@ -130,6 +146,103 @@ MotionSegment segment_from(const ParameterList& s, int dim, const std::string& k
   return seg;
 }
 
+template <int dim>
+Vec<dim> vecd(const Array<double>& a, const std::string& key) {
+  if (static_cast<int>(a.size()) != dim) bad(key, Teuchos::toString(a), std::to_string(dim) + " components");
+  Vec<dim> v;
+  for (int i = 0; i < dim; ++i) v(i) = a[i];
+  return v;
+}
+
+template <int dim>
+void build_mpm(const Scene& scene, const std::vector<std::string>& mat_names, SimulationSetup<dim>& setup) {
+  const ParameterList& p = scene.params;
+  const auto& bodies = p.sublist("MPM Bodies");
+  if (bodies.numParams() == 0) return;
+  const auto& m = p.sublist("MPM");
+  const double dx = m.get<double>("grid spacing");
+  MpmSetup<dim> mpm;
+  const std::string tr = m.get<std::string>("transfer");
+  mpm.scheme = tr == "PIC" ? TransferScheme::PIC : tr == "FLIP" ? TransferScheme::FLIP : TransferScheme::APIC;
+  try {
+    mpm.grid = grid_covering<dim>(vecd<dim>(m.get<Array<double>>("domain min"), "MPM/domain min"),
+                                  vecd<dim>(m.get<Array<double>>("domain max"), "MPM/domain max"), dx);
+  } catch (const std::invalid_argument& e) {
+    throw std::invalid_argument(std::string("scene sublist 'MPM': ") + e.what());
+  }
+  std::vector<Particles<dim>> parts;
+  int body_id = 0;
+  for (auto it = bodies.begin(); it != bodies.end(); ++it, ++body_id) {
+    const std::string name = bodies.name(it);
+    const std::string key = "MPM Bodies/" + name;
+    const auto& b = bodies.sublist(name);
+    SamplingShape shape;
+    shape.kind = b.get<std::string>("shape");
+    const auto c = b.get<Array<double>>("center");
+    shape.center.assign(c.begin(), c.end());
+    const auto sz = b.get<Array<double>>("size");
+    shape.size.assign(sz.begin(), sz.end());
+    shape.inner_radius = b.get<double>("inner radius");
+    shape.outer_radius = b.get<double>("outer radius");
+    MeshData mesh;
+    if (shape.kind == "mesh") {
+      std::filesystem::path f(b.get<std::string>("mesh file"));
+      if (f.is_relative()) f = std::filesystem::path(scene.base_dir) / f;
+      if (!std::filesystem::exists(f))
+        bad(key + "/mesh file", "'" + b.get<std::string>("mesh file") + "'", "an existing closed Gmsh .msh file");
+      mesh = read_gmsh_msh4(f.string(), dim);
+      shape.mesh = &mesh;
+    }
+    const int mat = static_cast<int>(std::find(mat_names.begin(), mat_names.end(), b.get<std::string>("material")) -
+                                     mat_names.begin());
+    Particles<dim> part;
+    try {
+      part = sample_particles<dim>(shape, dx, m.get<int>("particles per cell"), setup.materials[mat].density,
+                                   body_id, mat);
+    } catch (const std::invalid_argument& e) {
+      throw std::invalid_argument("scene key '" + key + "': " + e.what());
+    }
+    const auto v0 = vec3(b.get<Array<double>>("initial velocity"), dim, key + "/initial velocity");
+    for (int d = 0; d < dim; ++d) Kokkos::deep_copy(Kokkos::subview(part.v, Kokkos::ALL(), d), v0[d]);
+    parts.push_back(part);
+    mpm.body_names.push_back(name);
+  }
+  mpm.particles = concatenate(parts);
+  setup.mpm = mpm;
+  const auto& lss = p.sublist("Level Sets");
+  for (auto it = lss.begin(); it != lss.end(); ++it) {
+    const std::string key = "Level Sets/" + lss.name(it);
+    const auto& l = lss.sublist(lss.name(it));
+    LevelSet ls;
+    ls.name = lss.name(it);
+    ls.kind = l.get<std::string>("type") == "box" ? LevelSetKind::Box : LevelSetKind::HalfPlane;
+    ls.slip = l.get<bool>("slip");
+    ls.velocity = vec3(l.get<Array<double>>("velocity"), dim, key + "/velocity");
+    if (ls.kind == LevelSetKind::HalfPlane) {
+      ls.point = vec3(l.get<Array<double>>("point"), dim, key + "/point");  // default: origin
+      const Vec<dim> n = vecd<dim>(l.get<Array<double>>("normal"), key + "/normal");
+      if (!(n.norm() > 0)) bad(key + "/normal", Teuchos::toString(l.get<Array<double>>("normal")), "a non-zero normal");
+      const Vec<dim> u = n.normalized();
+      for (int d = 0; d < dim; ++d) ls.normal[d] = u(d);
+      int axis = 0;
+      u.cwiseAbs().maxCoeff(&axis);
+      ls.normal_axis = axis;
+      if (ls.slip && std::abs(std::abs(u(axis)) - 1.0) > 1e-12)
+        bad(key + "/normal", Teuchos::toString(l.get<Array<double>>("normal")),
+            "an axis-aligned normal for a slip boundary (general slip normals are not supported yet)");
+    } else {
+      const Vec<dim> lo = vecd<dim>(l.get<Array<double>>("box min"), key + "/box min");
+      const Vec<dim> hi = vecd<dim>(l.get<Array<double>>("box max"), key + "/box max");
+      for (int d = 0; d < dim; ++d) {
+        ls.box_min[d] = lo(d);
+        ls.box_max[d] = hi(d);
+      }
+      if (ls.slip) bad(key + "/slip", "true", "false for a box (slip needs a single normal)");
+    }
+    setup.level_sets.push_back(ls);
+  }
+}
+
 }  // namespace
 
 RunControl Scene::run_control() const {
@@ -163,7 +276,7 @@ Scene load_scene_from_string(const std::string& yaml, const std::string& base_di
 }
 
 template <int dim>
-SimulationSetup<dim> build_fem_setup(const Scene& scene) {
+SimulationSetup<dim> build_setup(const Scene& scene) {
   const ParameterList& p = scene.params;
   SimulationSetup<dim> setup;
   std::vector<std::string> mat_names;
@@ -228,6 +341,7 @@ SimulationSetup<dim> build_fem_setup(const Scene& scene) {
     node_offset += static_cast<LO>(in.mesh.num_nodes());
     setup.bodies.push_back(std::move(in));
   }
+  build_mpm<dim>(scene, mat_names, setup);
   const auto& time = p.sublist("Time");
   setup.dt = time.get<double>("dt");
   if (time.get<std::string>("integrator") == "newmark") {
@@ -243,8 +357,8 @@ SimulationSetup<dim> build_fem_setup(const Scene& scene) {
   return setup;
 }
 
-template SimulationSetup<2> build_fem_setup<2>(const Scene&);
-template SimulationSetup<3> build_fem_setup<3>(const Scene&);
+template SimulationSetup<2> build_setup<2>(const Scene&);
+template SimulationSetup<3> build_setup<3>(const Scene&);
 
 std::string scene_summary(const Scene& scene) {
   const auto& p = scene.params;
@@ -264,6 +378,19 @@ std::string scene_summary(const Scene& scene) {
       << " rho " << m.get<double>("density") << ", "
       << b.sublist("Boundary Conditions").numParams() << " prescribed set(s)\n";
   }
+  const auto& mpm = p.sublist("MPM Bodies");
+  for (auto it = mpm.begin(); it != mpm.end(); ++it) {
+    const auto& b = mpm.sublist(mpm.name(it));
+    const auto& m = p.sublist("Materials").sublist(b.get<std::string>("material"));
+    s << "  MPM body '" << mpm.name(it) << "': " << b.get<std::string>("shape") << ", "
+      << m.get<std::string>("model") << " E " << m.get<double>("E") << " nu " << m.get<double>("nu") << " rho "
+      << m.get<double>("density") << "\n";
+  }
+  if (mpm.numParams() > 0)
+    s << "  MPM grid dx " << p.sublist("MPM").get<double>("grid spacing") << ", "
+      << p.sublist("MPM").get<int>("particles per cell") << " particles per cell, "
+      << p.sublist("MPM").get<std::string>("transfer") << ", " << p.sublist("Level Sets").numParams()
+      << " level set(s)\n";
   return s.str();
 }
 

@@ -37,7 +37,7 @@ Scene load_scene_from_string(const std::string& yaml, const std::string& base_di
 
 // Builds meshes (files or Gmsh shapes), materials, motions and solver settings.
 template <int dim>
-SimulationSetup<dim> build_fem_setup(const Scene& scene);
+SimulationSetup<dim> build_setup(const Scene& scene);
 
 // A one-paragraph summary for the start of a run.
 std::string scene_summary(const Scene& scene);

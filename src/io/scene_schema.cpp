@@ -69,6 +69,33 @@ ParameterList body_schema() {
   return b;
 }
 
+ParameterList mpm_body_schema() {
+  ParameterList b("MPM body");
+  b.set("material", std::string(""), "name of an entry of Materials");
+  choice(b, "shape", "box", "region sampled with particles",
+         tuple<std::string>("box", "disk", "sphere", "ring", "half-ring", "mesh"));
+  b.set("center", Array<double>(), "m, dim components (default origin)");
+  b.set("size", Array<double>(), "box extents (m)");
+  b.set("inner radius", 0.0, "m (ring, half-ring)");
+  b.set("outer radius", 0.0, "m (disk, sphere, ring, half-ring)");
+  b.set("mesh file", std::string(""), "closed Gmsh MSH 4.1 mesh (shape mesh), relative to the scene");
+  b.set("initial velocity", Array<double>(), "m/s, dim components (default 0)");
+  return b;
+}
+
+ParameterList level_set_schema() {
+  ParameterList l("level set");
+  choice(l, "type", "half-plane", "solid where (x - point) . normal < 0, or inside a box",
+         tuple<std::string>("half-plane", "box"));
+  l.set("slip", false, "true: only the normal velocity is constrained (axis-aligned normals)");
+  l.set("point", Array<double>(), "half-plane: a point on the plane (m)");
+  l.set("normal", Array<double>(), "half-plane: normal pointing into the free side");
+  l.set("box min", Array<double>(), "box: lower corner (m)");
+  l.set("box max", Array<double>(), "box: upper corner (m)");
+  l.set("velocity", Array<double>(), "m/s, constant motion of the boundary (default 0)");
+  return l;
+}
+
 }  // namespace
 
 const ParameterList& scene_child_schema(const std::string& container) {
@@ -76,6 +103,10 @@ const ParameterList& scene_child_schema(const std::string& container) {
   static const ParameterList body = body_schema();
   static const ParameterList bc = bc_schema();
   static const ParameterList seg = segment_schema();
+  static const ParameterList mpm = mpm_body_schema();
+  static const ParameterList ls = level_set_schema();
+  if (container == "MPM Bodies") return mpm;
+  if (container == "Level Sets") return ls;
   if (container == "Materials") return mat;
   if (container == "FEM Bodies") return body;
   if (container == "Boundary Conditions") return bc;
@@ -85,7 +116,7 @@ const ParameterList& scene_child_schema(const std::string& container) {
 
 bool scene_is_container(const std::string& name) {
   return name == "Materials" || name == "FEM Bodies" || name == "Boundary Conditions" ||
-         name == "Motion";
+         name == "Motion" || name == "MPM Bodies" || name == "Level Sets";
 }
 
 Teuchos::RCP<const ParameterList> scene_schema() {
@@ -110,6 +141,14 @@ Teuchos::RCP<const ParameterList> scene_schema() {
   out.set("progress every", 10, "steps between progress lines (0: none)");
   pl->sublist("Materials", false, "named materials").disableRecursiveValidation();
   pl->sublist("FEM Bodies", false, "named FEM bodies").disableRecursiveValidation();
+  auto& mpm = pl->sublist("MPM", false, "background grid and transfers of the MPM bodies");
+  mpm.set("grid spacing", 0.0, "dx (m) of the uniform grid, > 0 when there are MPM bodies");
+  mpm.set("domain min", Array<double>(), "lower corner of the grid domain (m)");
+  mpm.set("domain max", Array<double>(), "upper corner of the grid domain (m)");
+  mpm.set("particles per cell", 4, "1, 4, 9, 16 (2D); 1, 8, 27 (3D)");
+  choice(mpm, "transfer", "APIC", "paper Tables 1-3", tuple<std::string>("APIC", "PIC", "FLIP"));
+  pl->sublist("MPM Bodies", false, "named MPM bodies (particles)").disableRecursiveValidation();
+  pl->sublist("Level Sets", false, "grid boundaries of the MPM bodies").disableRecursiveValidation();
   return pl;
 }
 

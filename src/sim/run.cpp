@@ -16,11 +16,14 @@ RunSummary run_dim(const Scene& scene, const std::string& dir, const Teuchos::RC
                    std::ostream& log) {
   Kokkos::Timer wall;
   const RunControl rc = scene.run_control();
-  Simulation<dim> sim(build_fem_setup<dim>(scene), comm);
+  Simulation<dim> sim(build_setup<dim>(scene), comm);
   const auto& mesh = sim.mesh();
   log << "FEM: " << mesh.num_nodes() << " nodes, " << mesh.num_cells() << " elements, "
-      << mesh.num_nodes() * dim << " DOFs; linear solver: " << sim.newton().linear_solver().describe()
-      << "\n";
+      << mesh.num_nodes() * dim << " DOFs";
+  if (const auto* mpm = sim.mpm())
+    log << "; MPM: " << mpm->particles().size() << " particles, " << transfer_scheme_name(mpm->scheme())
+        << ", grid " << mpm->grid().num_nodes() << " nodes (dx " << mpm->grid().dx << ")";
+  log << "; linear solver: " << sim.newton().linear_solver().describe() << "\n";
   RunOutput<dim> out(dir, scene, sim);
   out.write_frame(sim);
   const double dt = scene.params.sublist("Time").get<double>("dt");

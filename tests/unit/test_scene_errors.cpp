@@ -58,7 +58,7 @@ std::string scene_with(const std::string& from, const std::string& to, const std
 std::string error_of(const std::string& yaml, const std::vector<std::string>& sets = {}) {
   try {
     Scene s = load_scene_from_string(yaml, std::string(BFEMP_SOURCE_DIR) + "/tests/data", sets);
-    Simulation<2> sim(build_fem_setup<2>(s), bfemp::fixtures::comm());
+    Simulation<2> sim(build_setup<2>(s), bfemp::fixtures::comm());
   } catch (const std::invalid_argument& e) {
     return e.what();
   } catch (const std::exception& e) {
