@@ -70,12 +70,13 @@ void deformation_gradient(const DeformationStencils<dim, nv>& s, Kokkos::View<co
 // summed into the rows of free DOFs of `A` (local column ids == DOF ids).
 // Couplings to prescribed DOFs move to the right-hand side:
 // rhs(free) -= H(free, prescribed) * dx_prescribed(prescribed).
+// `project` = false assembles the exact Hessian (finite-difference tests).
 template <int dim, int nv, class LocalMatrix>
 void deformation_assemble(const DeformationStencils<dim, nv>& s, Kokkos::View<const double*, MemSpace> x,
                           double scale, Kokkos::View<double*, MemSpace> grad, const LocalMatrix& A,
                           Kokkos::View<const int*, MemSpace> prescribed,
                           Kokkos::View<const double*, MemSpace> dx_prescribed,
-                          Kokkos::View<double*, MemSpace> rhs) {
+                          Kokkos::View<double*, MemSpace> rhs, bool project = true) {
   constexpr int nd = nv * dim;
   constexpr int dd = dim * dim;
   Kokkos::parallel_for(
@@ -84,7 +85,8 @@ void deformation_assemble(const DeformationStencils<dim, nv>& s, Kokkos::View<co
         const Mat<dim> F = stencil_F(s, x, q);
         const double w = scale * s.volume(q);
         const Mat<dim> P = material_first_piola<dim>(mp, F);
-        const StressDerivative<dim> D = material_stress_derivative_psd<dim>(mp, F);
+        const StressDerivative<dim> D =
+            project ? material_stress_derivative_psd<dim>(mp, F) : material_stress_derivative<dim>(mp, F);
         LO dof[nd];
         for (int a = 0; a < nv; ++a)
           for (int k = 0; k < dim; ++k) dof[a * dim + k] = s.nodes(q, a) * dim + k;

@@ -55,13 +55,16 @@ class DeformationTerm : public EnergyTerm<dim> {
   }
   void assemble(ConstDofView x, double scale, DofView grad, const LocalMatrix& A, MaskView prescribed,
                 ConstDofView dx_prescribed, DofView rhs) const override {
-    deformation_assemble(s_, x, scale, grad, A, prescribed, dx_prescribed, rhs);
+    deformation_assemble(s_, x, scale, grad, A, prescribed, dx_prescribed, rhs, project_);
   }
+  // false: assemble the exact (unprojected) Hessian, for derivative tests.
+  void set_projection(bool project) { project_ = project; }
   double max_step(ConstDofView x, ConstDofView p) const override { return deformation_max_step(s_, x, p); }
 
  private:
   std::string name_;
   DeformationStencils<dim, nv> s_;
+  bool project_ = true;
 };
 
 }  // namespace bfemp
