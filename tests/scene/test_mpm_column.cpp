@@ -93,3 +93,22 @@ TEST(MpmExtremeStep, HundredTimesCflConvergesInversionFree) {
   std::cout << "dt = " << s.dt << " s (100x CFL): " << iterates << " Newton iterates in 5 steps, min J over iterates "
             << min_J_iterates << "\n";
 }
+
+// A particle that leaves the grid domain stops the run with an error naming
+// the particle and the step, never a crash.
+TEST(MpmDomain, ParticleLeavingTheGridIsAClearError) {
+  auto s = mpm_rect_setup(0.2, 0.2, Vec<2>(0.5, 0.5), 0.05, 4, Vec<2>(0.0, 0.0), Vec<2>(1.0, 1.0),
+                          TransferScheme::PIC, E, 0.3, rho);
+  s.dt = 0.05;
+  Simulation<2> sim(s, fixtures::comm());
+  Kokkos::deep_copy(Kokkos::subview(sim.mpm()->particles().v, Kokkos::ALL(), 0), 2.0);
+  try {
+    for (int k = 0; k < 20; ++k) sim.step();
+    FAIL() << "the block left the grid without an error";
+  } catch (const std::runtime_error& e) {
+    const std::string msg = e.what();
+    EXPECT_NE(msg.find("MPM particle"), std::string::npos) << msg;
+    EXPECT_NE(msg.find("left the grid domain"), std::string::npos) << msg;
+    EXPECT_NE(msg.find("step "), std::string::npos) << msg;
+  }
+}

@@ -152,3 +152,32 @@ TEST(SceneErrors, UnknownNodeSetAndMaterial) {
 TEST(SceneErrors, OverrideOfUnknownKey) {
   expect_message(error_of(scene_with("", ""), {"Time/dtt=1.0"}), {"Time/dtt", "unknown key"});
 }
+
+TEST(SceneErrors, MpmGridAndSampling) {
+  const std::string mpm = R"(%YAML 1.1
+---
+bfemp:
+  dimension: 2
+  Materials:
+    soft: {E: 1.0e5, nu: 0.3, density: 1000.0}
+  MPM:
+    grid spacing: 0.05
+    domain min: [0.0, 0.0]
+    domain max: [1.0, 1.0]
+    particles per cell: 4
+  MPM Bodies:
+    block: {material: soft, shape: box, center: [0.5, 0.5], size: [0.2, 0.2]}
+...
+)";
+  auto with = [&](const std::string& from, const std::string& to) {
+    std::string s = mpm;
+    s.replace(s.find(from), from.size(), to);
+    return s;
+  };
+  EXPECT_EQ(error_of(mpm), "");
+  expect_message(error_of(with("grid spacing: 0.05", "grid spacing: 0.0")), {"MPM/grid spacing", "0", "dx > 0"});
+  expect_message(error_of(with("particles per cell: 4", "particles per cell: 5")),
+                 {"MPM/particles per cell", "5", "1, 4, 9 or 16"});
+  expect_message(error_of(with("domain max: [1.0, 1.0]", "domain max: [1.0]")), {"MPM/domain max", "2 components"});
+  expect_message(error_of(with("shape: box", "shape: blob")), {"MPM Bodies/block/shape", "blob"});
+}
