@@ -53,7 +53,7 @@ std::vector<Vec<dim>> test_positions(const GridSpec<dim>& g, std::mt19937& rng) 
       // Snapped positions stay off the usable range's ends s = 1/2 and
       // n - 1/2, where rounding of x decides (tested on their own below).
       if (kind == 1) s = std::floor(std::max(s, 1.0) - 0.5) + 1.0;  // node
-      if (kind == 2) s = std::floor(std::max(s, 1.0) - 0.5) + 0.5;  // cell centre
+      if (kind == 2) s = std::floor(std::max(s, 1.5) - 0.5) + 0.5;  // cell centre, >= 1.5
       x[d] = g.origin[d] + g.dx * s;
     }
     xs.push_back(x);
