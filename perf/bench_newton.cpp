@@ -65,14 +65,16 @@ struct Options {
   std::string out = "newton.json";
 };
 
+// Prints the usage (after `msg`, if any) and exits: 0 for --help, 2 otherwise.
 [[noreturn]] void usage(const std::string& msg) {
-  std::cerr << "bench_newton: " << msg << "\n"
-            << "usage: bench_newton [--dims 2,3] [--sizes small,medium,large]\n"
-               "                    [--solvers Cholmod,KLU2,CG] [--cg-preconditioner "
-               "SGS|JACOBI|CHEBYSHEV|RILUK|NONE]\n"
-               "                    [--steps N] [--dt SECONDS] [--velocity vx,vy[,vz]]\n"
-               "                    [--no-skip] [--mesh-only] [--out FILE]\n";
-  std::exit(2);
+  std::ostream& os = msg.empty() ? std::cout : std::cerr;
+  if (!msg.empty()) os << "bench_newton: " << msg << "\n";
+  os << "usage: bench_newton [--dims 2,3] [--sizes small,medium,large]\n"
+        "                    [--solvers Cholmod,KLU2,CG] [--cg-preconditioner "
+        "SGS|JACOBI|CHEBYSHEV|RILUK|NONE]\n"
+        "                    [--steps N] [--dt SECONDS] [--velocity vx,vy[,vz]]\n"
+        "                    [--no-skip] [--mesh-only] [--out FILE]\n";
+  std::exit(msg.empty() ? 0 : 2);
 }
 
 Options parse(int argc, char** argv) {
@@ -121,7 +123,7 @@ Options parse(int argc, char** argv) {
     } else if (a == "--out") {
       o.out = value();
     } else if (a == "--help" || a == "-h") {
-      usage("help");
+      usage("");
     } else {
       usage("unknown option '" + a + "'");
     }
@@ -185,7 +187,7 @@ std::string prec_description(const std::string& prec) {
 
 template <int dim>
 SimulationSetup<dim> make_setup(const MeshData& mesh, const Teuchos::ParameterList& ls, double dt,
-                         const std::array<double, 3>& v0) {
+                                const std::array<double, 3>& v0) {
   SimulationSetup<dim> s;
   s.bodies.push_back(FemBodyInput{"block", mesh, 0});
   s.materials.push_back(MaterialParams{MaterialModel::NeoHookean, lame_from_young(1e6, 0.3), 1000.0});

@@ -9,9 +9,9 @@
 
 RUN.json is what perf/run_benchmarks.sh writes (or a single bench_newton
 output); with several runs, each timing is the best (minimum) of them, which
-filters out most of the noise of a shared machine. Configurations are matched on (dim, size, solver, threads). For every
-timing field the table shows the baseline, the new value and their ratio; a
-timing regresses when
+filters out most of the noise of a shared machine. Configurations are matched
+on (dim, size, solver, threads). For every timing field the table shows the
+baseline, the new value and their ratio; a timing regresses when
 
     now > baseline * (1 + threshold)   and   now - baseline > min_abs
 
@@ -36,9 +36,12 @@ def load(path):
         with open(path) as f:
             data = json.load(f)
     except (OSError, ValueError) as e:
-        sys.exit(f"compare.py: cannot read {path}: {e}")
+        print(f"compare.py: cannot read {path}: {e}", file=sys.stderr)
+        sys.exit(2)
     if "results" not in data:
-        sys.exit(f"compare.py: {path} has no 'results' (not a bench_newton output?)")
+        print(f"compare.py: {path} has no 'results' (not a bench_newton output?)",
+              file=sys.stderr)
+        sys.exit(2)
     table = {}
     for r in data["results"]:
         key = (r["dim"], r["size"], r["solver"], r["threads"])
