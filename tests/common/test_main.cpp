@@ -1,11 +1,17 @@
 // GoogleTest main for every bfemp test: brings up MPI, Kokkos and Tpetra once.
 #include <gtest/gtest.h>
+
+#include <cstdlib>
 #include <mpi.h>
 
 #include <Kokkos_Core.hpp>
 #include <Tpetra_Core.hpp>
 
 int main(int argc, char** argv) {
+  // Kokkos warns on stdout when OMP_PROC_BIND is unset; gtest_discover_tests
+  // (which runs the binaries without the test environment) would read the
+  // warning as test names. Tests run unbound unless told otherwise.
+  setenv("OMP_PROC_BIND", "false", /*overwrite=*/0);
   int provided = 0;
   MPI_Init_thread(&argc, &argv, MPI_THREAD_FUNNELED, &provided);
   ::testing::InitGoogleTest(&argc, argv);
