@@ -32,6 +32,14 @@ class EnergyTerm {
                         ConstDofView dx_prescribed, DofView rhs) const = 0;
   // Largest step along p keeping the term defined (inf if unbounded).
   virtual double max_step(ConstDofView x, ConstDofView p) const = 0;
+  // Called at every Newton iterate x before its assembly (contact: the pairs
+  // near x; terms keep such caches as mutable state). Returns true when the term now needs couplings the current graph
+  // lacks; the solver then rebuilds the graph (add_couplings is asked again).
+  virtual bool update(ConstDofView /*x*/) const { return false; }
+  // Called once the Newton direction p is known, before max_step and the
+  // energies of the line search along x + t p, t in [0, 1] (contact: the pairs
+  // the segment can bring within reach).
+  virtual void prepare_direction(ConstDofView /*x*/, ConstDofView /*p*/) const {}
 };
 
 // Elasticity over deformation stencils (FEM elements or MPM particles).

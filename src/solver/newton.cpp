@@ -172,6 +172,9 @@ NewtonStats NewtonSolver<dim>::minimize(const IncrementalPotential& ip, View1 x)
         Kokkos::Max<double>(pres_left));
 
     timer.reset();
+    bool grow = false;
+    for (const auto* t : m.terms) grow = t->update(x) || grow;
+    if (grow) m.rebuild(m.n_nodes);
     m.assemble(ip, x);
     Kokkos::fence();
     st.assembly_s += timer.seconds();
@@ -202,6 +205,7 @@ NewtonStats NewtonSolver<dim>::minimize(const IncrementalPotential& ip, View1 x)
     if (!std::isfinite(p_inf))
       throw SolverError("Newton direction is not finite (linear solve produced NaN/Inf)");
 
+    for (const auto* t : m.terms) t->prepare_direction(x, dir);
     double a_max = std::numeric_limits<double>::infinity();
     for (const auto* t : m.terms) a_max = std::min(a_max, t->max_step(x, dir));
     double alpha = std::min(1.0, 0.9 * a_max);
