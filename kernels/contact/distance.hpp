@@ -1,0 +1,191 @@
+#pragma once
+// Squared distances of the contact stencils (paper §4, Eqs. 31-32):
+// point-point, point-edge (2D and 3D) and point-triangle (3D), each with the
+// closest-feature case analysis, and (below) their gradients and Hessians.
+//
+// Every case is a squared norm d2 = |w|^2 of a "closest vector"
+//   w = sum_i c_i(b) x_i,   x = (p, v_0, v_1, ...) stacked,
+// with c_i affine in nb free parameters b (nb = 0 for point-point, 1 for
+// point-line, 2 for point-plane) at their unconstrained optimum dd2/db = 0.
+// The case decides which features are active; the value returned is always
+// the one of the case reported, and the derivatives are those of that value.
+#include <Kokkos_Core.hpp>
+#include <algorithm>
+#include <cmath>
+
+#include "core/types.hpp"
+
+namespace bfemp {
+
+template <int n>
+struct Distance2 {
+  double d2;
+  Eigen::Matrix<double, n, 1> grad;
+  Eigen::Matrix<double, n, n> hess;
+};
+
+// Closest feature of the edge (e0, e1) to p: an endpoint or the interior.
+enum class PointEdgeCase : int { P_E0 = 0, P_E1 = 1, P_E = 2 };
+// Closest feature of the triangle (t0, t1, t2) to p: a vertex, an edge
+// (E01 = t0->t1, E12 = t1->t2, E20 = t2->t0) or the interior.
+enum class PointTriangleCase : int { P_T0, P_T1, P_T2, P_E01, P_E12, P_E20, P_T };
+
+namespace contact_detail {
+
+// A triangle is treated as collinear (zero area) when
+// |e1 x e2|^2 <= kDegenerateSin2 |e1|^2 |e2|^2, i.e. sin(angle) <= 1e-8: its
+// plane is then too ill-defined for the interior case, and the distance is
+// the minimum of the three point-edge distances (error <= 1e-8 * edge length).
+constexpr double kDegenerateSin2 = 1e-16;
+
+// Edge parameter beta of the closest point (1 - beta) e0 + beta e1 and the case.
+// beta* = (p - e0).e / |e|^2 clamped to [0, 1]; a zero-length edge is P_E0.
+template <int dim>
+struct PointEdgeClosest {
+  PointEdgeCase c;
+  double beta;
+};
+
+template <int dim>
+KOKKOS_INLINE_FUNCTION PointEdgeClosest<dim> point_edge_closest(const Vec<dim>& p, const Vec<dim>& e0,
+                                                               const Vec<dim>& e1) {
+  const Vec<dim> e = e1 - e0;
+  const double ee = e.squaredNorm();
+  if (!(ee > 0)) return {PointEdgeCase::P_E0, 0.0};
+  const double beta = (p - e0).dot(e) / ee;
+  if (!(beta > 0)) return {PointEdgeCase::P_E0, 0.0};  // also catches NaN
+  if (beta >= 1) return {PointEdgeCase::P_E1, 1.0};
+  return {PointEdgeCase::P_E, beta};
+}
+
+// Closest feature of a triangle with the parameters of that feature:
+// interior (b1, b2) or, for edge cases, beta along the edge's own direction.
+struct PointTriangleClosest {
+  PointTriangleCase c;
+  double b1, b2;  // closest = (1 - b1 - b2) t0 + b1 t1 + b2 t2
+  double beta;    // edge cases: closest = (1 - beta) ta + beta tb
+  double d2;
+};
+
+// The squared distance of the case in `c`: endpoints exactly |p - e_k|^2,
+// interior |p - e0 - beta (e1 - e0)|^2 (the point-line distance, evaluated
+// through the closest point: no cancellation as in |r|^2 - (r.e)^2/|e|^2).
+template <int dim>
+KOKKOS_INLINE_FUNCTION double point_edge_d2_from(const Vec<dim>& p, const Vec<dim>& e0, const Vec<dim>& e1,
+                                                 const PointEdgeClosest<dim>& c) {
+  switch (c.c) {
+    case PointEdgeCase::P_E0: return (p - e0).squaredNorm();
+    case PointEdgeCase::P_E1: return (p - e1).squaredNorm();
+    default: return (p - (e0 + c.beta * (e1 - e0))).squaredNorm();
+  }
+}
+
+KOKKOS_INLINE_FUNCTION PointTriangleClosest point_triangle_closest(const Vec<3>& p, const Vec<3>& t0,
+                                                                  const Vec<3>& t1, const Vec<3>& t2) {
+  const Vec<3> e1 = t1 - t0, e2 = t2 - t0, r = p - t0;
+  // Barycentrics are scale-invariant: compute them on the triangle scaled to
+  // unit size, so that tiny (or huge) triangles do not under/overflow |n|^2.
+  const double L = std::sqrt(std::max(e1.squaredNorm(), e2.squaredNorm()));
+  if (L > 0 && std::isfinite(L)) {
+    const Vec<3> f1 = e1 / L, f2 = e2 / L, s = r / L;
+    const Vec<3> n = f1.cross(f2);
+    const double nn = n.squaredNorm();
+    if (nn > kDegenerateSin2 * f1.squaredNorm() * f2.squaredNorm()) {
+      // Barycentrics of the projection of p on the plane, from
+      // s = b1 f1 + b2 f2 + c n:  (s x f2).n = b1 |n|^2,  (f1 x s).n = b2 |n|^2.
+      const double b1 = s.cross(f2).dot(n) / nn;
+      const double b2 = f1.cross(s).dot(n) / nn;
+      if (b1 >= 0 && b2 >= 0 && b1 + b2 <= 1) {
+        const Vec<3> w = r - b1 * e1 - b2 * e2;
+        return {PointTriangleCase::P_T, b1, b2, 0.0, w.squaredNorm()};
+      }
+    }
+  }
+  // Projection outside (or no usable plane): the triangle is convex, so the
+  // closest point lies on its boundary: the nearest of the three edges.
+  // Ties keep the first edge in the order E01, E12, E20.
+  const PointEdgeClosest<3> c01 = point_edge_closest<3>(p, t0, t1);
+  const PointEdgeClosest<3> c12 = point_edge_closest<3>(p, t1, t2);
+  const PointEdgeClosest<3> c20 = point_edge_closest<3>(p, t2, t0);
+  const double d01 = point_edge_d2_from<3>(p, t0, t1, c01);
+  const double d12 = point_edge_d2_from<3>(p, t1, t2, c12);
+  const double d20 = point_edge_d2_from<3>(p, t2, t0, c20);
+  int k = 0;
+  double d = d01;
+  if (d12 < d) k = 1, d = d12;
+  if (d20 < d) k = 2, d = d20;
+  PointTriangleClosest out{PointTriangleCase::P_T, 0.0, 0.0, 0.0, d};
+  // Vertex cases come from the edge's endpoint cases; (b1, b2) from beta.
+  if (k == 0) {
+    out.beta = c01.beta;
+    out.c = c01.c == PointEdgeCase::P_E0   ? PointTriangleCase::P_T0
+            : c01.c == PointEdgeCase::P_E1 ? PointTriangleCase::P_T1
+                                           : PointTriangleCase::P_E01;
+    out.b1 = c01.beta;  // (1 - beta) t0 + beta t1
+    out.b2 = 0;
+  } else if (k == 1) {
+    out.beta = c12.beta;
+    out.c = c12.c == PointEdgeCase::P_E0   ? PointTriangleCase::P_T1
+            : c12.c == PointEdgeCase::P_E1 ? PointTriangleCase::P_T2
+                                           : PointTriangleCase::P_E12;
+    out.b1 = 1 - c12.beta;  // (1 - beta) t1 + beta t2
+    out.b2 = c12.beta;
+  } else {
+    out.beta = c20.beta;
+    out.c = c20.c == PointEdgeCase::P_E0   ? PointTriangleCase::P_T2
+            : c20.c == PointEdgeCase::P_E1 ? PointTriangleCase::P_T0
+                                           : PointTriangleCase::P_E20;
+    out.b1 = 0;  // (1 - beta) t2 + beta t0
+    out.b2 = 1 - c20.beta;
+  }
+  return out;
+}
+
+}  // namespace contact_detail
+
+// ---------------------------------------------------------------- values
+
+// d2 = |p - q|^2.
+template <int dim>
+KOKKOS_INLINE_FUNCTION double point_point_distance2(const Vec<dim>& p, const Vec<dim>& q) {
+  return (p - q).squaredNorm();
+}
+
+template <int dim>
+KOKKOS_INLINE_FUNCTION PointEdgeCase point_edge_case(const Vec<dim>& p, const Vec<dim>& e0, const Vec<dim>& e1) {
+  return contact_detail::point_edge_closest<dim>(p, e0, e1).c;
+}
+
+// beta in [0, 1] of the closest point (1 - beta) e0 + beta e1.
+template <int dim>
+KOKKOS_INLINE_FUNCTION double point_edge_closest_parameter(const Vec<dim>& p, const Vec<dim>& e0,
+                                                           const Vec<dim>& e1) {
+  return contact_detail::point_edge_closest<dim>(p, e0, e1).beta;
+}
+
+// P_E0: |p - e0|^2, P_E1: |p - e1|^2, P_E: squared point-line distance.
+template <int dim>
+KOKKOS_INLINE_FUNCTION double point_edge_distance2(const Vec<dim>& p, const Vec<dim>& e0, const Vec<dim>& e1) {
+  return contact_detail::point_edge_d2_from<dim>(p, e0, e1, contact_detail::point_edge_closest<dim>(p, e0, e1));
+}
+
+KOKKOS_INLINE_FUNCTION PointTriangleCase point_triangle_case(const Vec<3>& p, const Vec<3>& t0, const Vec<3>& t1,
+                                                            const Vec<3>& t2) {
+  return contact_detail::point_triangle_closest(p, t0, t1, t2).c;
+}
+
+// (b1, b2) of the closest point (1 - b1 - b2) t0 + b1 t1 + b2 t2.
+KOKKOS_INLINE_FUNCTION Vec<2> point_triangle_closest_barycentric(const Vec<3>& p, const Vec<3>& t0,
+                                                                const Vec<3>& t1, const Vec<3>& t2) {
+  const auto c = contact_detail::point_triangle_closest(p, t0, t1, t2);
+  return Vec<2>(c.b1, c.b2);
+}
+
+// Interior: squared distance to the plane; otherwise (and for collinear
+// triangles) the nearest edge's point-edge distance.
+KOKKOS_INLINE_FUNCTION double point_triangle_distance2(const Vec<3>& p, const Vec<3>& t0, const Vec<3>& t1,
+                                                      const Vec<3>& t2) {
+  return contact_detail::point_triangle_closest(p, t0, t1, t2).d2;
+}
+
+}  // namespace bfemp
