@@ -188,4 +188,132 @@ KOKKOS_INLINE_FUNCTION double point_triangle_distance2(const Vec<3>& p, const Ve
   return contact_detail::point_triangle_closest(p, t0, t1, t2).d2;
 }
 
+// ---------------------------------------------------------------- derivatives
+
+namespace contact_detail {
+
+// Derivatives of one case, d2(x) = |w|^2 with w = sum_i c_i x_i over the nv
+// stencil vertices x = (p, v_0, ...), the c_i constant (point-point) or
+// affine in nb free parameters b at their optimum dd2/db = 0:
+//   gradient (envelope theorem, dd2/db = 0):   dd2/dx_i = 2 c_i w;
+//   Hessian (implicit function theorem):       H = 2 (c c^T (x) I) - 2 N G^-1 N^T
+// with u_k = dw/db_k = sum_i (dc_i/db_k) x_i, G_kl = u_k.u_l (so d2d2/db2 = 2G),
+// and column k of N, block i: (dc_i/db_k) w + c_i u_k (= (1/2) d2d2/dx_i db_k),
+// which follows from db*/dx = -(2G)^-1 (2N)^T.
+
+// nb = 0: point-point in disguise, H = 2 (c c^T (x) I).
+template <int dim, int nv>
+KOKKOS_INLINE_FUNCTION Distance2<nv * dim> stencil_distance2(const Vec<dim>& w,
+                                                             const Eigen::Matrix<double, nv, 1>& c) {
+  Distance2<nv * dim> out;
+  out.d2 = w.squaredNorm();
+  for (int i = 0; i < nv; ++i) {
+    out.grad.template segment<dim>(i * dim) = 2 * c(i) * w;
+    for (int j = 0; j < nv; ++j)
+      out.hess.template block<dim, dim>(i * dim, j * dim) = (2 * c(i) * c(j)) * Mat<dim>::Identity();
+  }
+  return out;
+}
+
+// nb = 1 (point-line) and nb = 2 (point-plane): the correction -2 N G^-1 N^T.
+template <int dim, int nv, int nb>
+KOKKOS_INLINE_FUNCTION Distance2<nv * dim> stencil_distance2(const Vec<dim>& w,
+                                                             const Eigen::Matrix<double, nv, 1>& c,
+                                                             const Eigen::Matrix<double, nv, nb>& dc,
+                                                             const Eigen::Matrix<double, dim, nb>& U,
+                                                             const SquareMat<nb>& Ginv) {
+  Distance2<nv * dim> out = stencil_distance2<dim, nv>(w, c);
+  Eigen::Matrix<double, nv * dim, nb> N;
+  for (int k = 0; k < nb; ++k)
+    for (int i = 0; i < nv; ++i) N.template block<dim, 1>(i * dim, k) = dc(i, k) * w + c(i) * U.col(k);
+  out.hess -= 2 * N * Ginv * N.transpose();
+  return out;
+}
+
+// The edge case "closest point (1 - beta) x_a + beta x_b" of an nv-vertex
+// stencil (slot 0 is the point): w = p - (x_a + beta (x_b - x_a)),
+// c_0 = 1, c_a = -(1 - beta), c_b = -beta; dc_a = 1, dc_b = -1; u = x_a - x_b.
+template <int dim, int nv>
+KOKKOS_INLINE_FUNCTION Distance2<nv * dim> stencil_point_edge(const Vec<dim>& p, const Vec<dim>& xa,
+                                                              const Vec<dim>& xb, int a, int b, double beta) {
+  Eigen::Matrix<double, nv, 1> c = Eigen::Matrix<double, nv, 1>::Zero();
+  Eigen::Matrix<double, nv, 1> dc = Eigen::Matrix<double, nv, 1>::Zero();
+  c(0) = 1;
+  c(a) = -(1 - beta);
+  c(b) = -beta;
+  dc(a) = 1;
+  dc(b) = -1;
+  const Vec<dim> u = xa - xb;
+  SquareMat<1> Ginv;
+  Ginv(0, 0) = 1 / u.squaredNorm();
+  const Vec<dim> w = p - (xa + beta * (xb - xa));
+  return stencil_distance2<dim, nv, 1>(w, c, dc, u, Ginv);
+}
+
+// The vertex case "closest point x_a": w = p - x_a, c_0 = 1, c_a = -1.
+template <int dim, int nv>
+KOKKOS_INLINE_FUNCTION Distance2<nv * dim> stencil_point_point(const Vec<dim>& p, const Vec<dim>& xa, int a) {
+  Eigen::Matrix<double, nv, 1> c = Eigen::Matrix<double, nv, 1>::Zero();
+  c(0) = 1;
+  c(a) = -1;
+  return stencil_distance2<dim, nv>(p - xa, c);
+}
+
+}  // namespace contact_detail
+
+// Variables (p, q).
+template <int dim>
+KOKKOS_INLINE_FUNCTION Distance2<2 * dim> point_point_distance2_derivatives(const Vec<dim>& p, const Vec<dim>& q) {
+  return contact_detail::stencil_point_point<dim, 2>(p, q, 1);
+}
+
+// Variables (p, e0, e1); derivatives of the case point_edge_distance2 returns.
+template <int dim>
+KOKKOS_INLINE_FUNCTION Distance2<3 * dim> point_edge_distance2_derivatives(const Vec<dim>& p, const Vec<dim>& e0,
+                                                                          const Vec<dim>& e1) {
+  const auto cl = contact_detail::point_edge_closest<dim>(p, e0, e1);
+  switch (cl.c) {
+    case PointEdgeCase::P_E0: return contact_detail::stencil_point_point<dim, 3>(p, e0, 1);
+    case PointEdgeCase::P_E1: return contact_detail::stencil_point_point<dim, 3>(p, e1, 2);
+    default: return contact_detail::stencil_point_edge<dim, 3>(p, e0, e1, 1, 2, cl.beta);
+  }
+}
+
+// Variables (p, t0, t1, t2); derivatives of the case point_triangle_distance2
+// returns (collinear triangles: of the nearest edge's case, mapped).
+KOKKOS_INLINE_FUNCTION Distance2<12> point_triangle_distance2_derivatives(const Vec<3>& p, const Vec<3>& t0,
+                                                                         const Vec<3>& t1, const Vec<3>& t2) {
+  namespace cd = contact_detail;
+  const cd::PointTriangleClosest cl = cd::point_triangle_closest(p, t0, t1, t2);
+  switch (cl.c) {
+    case PointTriangleCase::P_T0: return cd::stencil_point_point<3, 4>(p, t0, 1);
+    case PointTriangleCase::P_T1: return cd::stencil_point_point<3, 4>(p, t1, 2);
+    case PointTriangleCase::P_T2: return cd::stencil_point_point<3, 4>(p, t2, 3);
+    case PointTriangleCase::P_E01: return cd::stencil_point_edge<3, 4>(p, t0, t1, 1, 2, cl.beta);
+    case PointTriangleCase::P_E12: return cd::stencil_point_edge<3, 4>(p, t1, t2, 2, 3, cl.beta);
+    case PointTriangleCase::P_E20: return cd::stencil_point_edge<3, 4>(p, t2, t0, 3, 1, cl.beta);
+    default: break;
+  }
+  // Interior: w = r - b1 e1 - b2 e2, c = (1, -(1 - b1 - b2), -b1, -b2),
+  // dc/db = [[0, 0], [1, 1], [-1, 0], [0, -1]], U = (t0 - t1, t0 - t2),
+  // G = U^T U (det G = |e1 x e2|^2). G^-1 is formed on the triangle scaled to
+  // unit size L (as in the case test) and scaled back by 1/L^2.
+  const Vec<3> e1 = t1 - t0, e2 = t2 - t0;
+  const double b1 = cl.b1, b2 = cl.b2;
+  Eigen::Matrix<double, 4, 1> c(1, -(1 - b1 - b2), -b1, -b2);
+  Eigen::Matrix<double, 4, 2> dc;
+  dc << 0, 0, 1, 1, -1, 0, 0, -1;
+  Eigen::Matrix<double, 3, 2> U;
+  U.col(0) = -e1;
+  U.col(1) = -e2;
+  const double L = std::sqrt(std::max(e1.squaredNorm(), e2.squaredNorm()));
+  const Vec<3> f1 = e1 / L, f2 = e2 / L;
+  const double det = f1.cross(f2).squaredNorm();
+  SquareMat<2> Ginv;
+  Ginv << f2.squaredNorm(), -f1.dot(f2), -f1.dot(f2), f1.squaredNorm();
+  Ginv /= det * L * L;
+  const Vec<3> w = (p - t0) - b1 * e1 - b2 * e2;
+  return cd::stencil_distance2<3, 4, 2>(w, c, dc, U, Ginv);
+}
+
 }  // namespace bfemp

@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <random>
 
@@ -253,6 +254,231 @@ TEST(ContactDistance, PointTriangleDegenerate) {
               PointTriangleCase::P_T);
     EXPECT_NEAR(point_triangle_distance2(q, Vec<3>::Zero(), s * Vec<3>(1, 0, 0), s * Vec<3>(0, 1, 0)) / (s * s),
                 0.25, 1e-14);
+  }
+}
+
+// ------------------------------------------------------------ derivatives
+
+// Finite-difference check of one stencil function F(x) -> Distance2<n> at x:
+// gradient against central differences of the value, Hessian against central
+// differences of the gradient, step h = 1e-6 * (1 + |x|_inf). `same_case`
+// tells whether x + dx lies in the case of x (checks are on one case only).
+struct FdErrors {
+  double grad = 0, hess = 0;
+};
+
+template <int n, class F, class SameCase>
+FdErrors fd_check(const Eigen::Matrix<double, n, 1>& x, const F& f, const SameCase& same_case) {
+  const double h = 1e-6 * (1 + x.template lpNorm<Eigen::Infinity>());
+  const Distance2<n> d = f(x);
+  EXPECT_NEAR(d.d2, f(x).d2, 0.0);
+  EXPECT_LE((d.hess - d.hess.transpose()).norm(), 1e-14 * (1 + d.hess.norm()));
+  Eigen::Matrix<double, n, 1> g_fd;
+  Eigen::Matrix<double, n, n> H_fd;
+  for (int j = 0; j < n; ++j) {
+    Eigen::Matrix<double, n, 1> xp = x, xm = x;
+    xp(j) += h;
+    xm(j) -= h;
+    EXPECT_TRUE(same_case(xp) && same_case(xm)) << "step crosses a case boundary";
+    const Distance2<n> dp = f(xp), dm = f(xm);
+    g_fd(j) = (dp.d2 - dm.d2) / (2 * h);
+    H_fd.col(j) = (dp.grad - dm.grad) / (2 * h);
+  }
+  FdErrors e;
+  e.grad = (d.grad - g_fd).norm() / std::max(d.grad.norm(), 1e-300);
+  e.hess = (d.hess - H_fd).norm() / std::max(d.hess.norm(), 1e-300);
+  return e;
+}
+
+template <int dim>
+Eigen::Matrix<double, 3 * dim, 1> stack(const Vec<dim>& a, const Vec<dim>& b, const Vec<dim>& c) {
+  Eigen::Matrix<double, 3 * dim, 1> x;
+  x << a, b, c;
+  return x;
+}
+
+template <int dim>
+void check_point_edge_derivatives() {
+  constexpr int n = 3 * dim;
+  auto f = [](const Eigen::Matrix<double, n, 1>& x) {
+    return point_edge_distance2_derivatives<dim>(x.template segment<dim>(0), x.template segment<dim>(dim),
+                                                 x.template segment<dim>(2 * dim));
+  };
+  auto kase = [](const Eigen::Matrix<double, n, 1>& x) {
+    return point_edge_case<dim>(x.template segment<dim>(0), x.template segment<dim>(dim),
+                                x.template segment<dim>(2 * dim));
+  };
+  // One point per case on a general edge, plus random configurations.
+  const Vec<dim> e0 = v<dim>(0.1, -0.2, 0.3), e1 = v<dim>(1.7, 0.4, -0.5);
+  std::vector<Eigen::Matrix<double, n, 1>> xs = {
+      stack<dim>(v<dim>(-0.8, 0.5, 0.2), e0, e1),  // P_E0
+      stack<dim>(v<dim>(2.5, 0.1, 0.4), e0, e1),   // P_E1
+      stack<dim>(v<dim>(0.9, 0.9, 0.6), e0, e1),   // P_E
+  };
+  const PointEdgeCase expected[] = {PointEdgeCase::P_E0, PointEdgeCase::P_E1, PointEdgeCase::P_E};
+  std::mt19937 rng(10 + dim);
+  std::uniform_real_distribution<double> u(-1, 1);
+  for (int i = 0; i < 200; ++i) {
+    Eigen::Matrix<double, n, 1> x;
+    for (int k = 0; k < n; ++k) x(k) = u(rng);
+    xs.push_back(x);
+  }
+  FdErrors worst[3];
+  int tested[3] = {};
+  for (size_t i = 0; i < xs.size(); ++i) {
+    const PointEdgeCase c = kase(xs[i]);
+    if (i < 3) {
+      EXPECT_EQ(c, expected[i]);
+    }
+    const auto same = [&](const Eigen::Matrix<double, n, 1>& y) { return kase(y) == c; };
+    // Random samples near a case boundary are skipped, not tested across it.
+    bool inside = true;
+    for (int j = 0; j < n && i >= 3; ++j)
+      for (double sgn : {-1.0, 1.0}) {
+        Eigen::Matrix<double, n, 1> y = xs[i];
+        y(j) += sgn * 1e-6 * (1 + xs[i].template lpNorm<Eigen::Infinity>());
+        inside = inside && same(y);
+      }
+    if (!inside) continue;
+    const FdErrors e = fd_check<n>(xs[i], f, same);
+    const int k = static_cast<int>(c);
+    ++tested[k];
+    worst[k].grad = std::max(worst[k].grad, e.grad);
+    worst[k].hess = std::max(worst[k].hess, e.hess);
+    // The value of the derivatives struct is the value function's.
+    EXPECT_EQ(f(xs[i]).d2, point_edge_distance2<dim>(xs[i].template segment<dim>(0),
+                                                     xs[i].template segment<dim>(dim),
+                                                     xs[i].template segment<dim>(2 * dim)));
+  }
+  for (int k = 0; k < 3; ++k) {
+    EXPECT_GT(tested[k], 1) << "case " << k;
+    EXPECT_LT(worst[k].grad, 1e-6) << "case " << k;
+    EXPECT_LT(worst[k].hess, 1e-5) << "case " << k;
+    std::printf("point-edge %dD case %d: %d configurations, worst rel. error grad %.2e hess %.2e\n", dim, k,
+                tested[k], worst[k].grad, worst[k].hess);
+  }
+}
+
+TEST(ContactDistance, PointEdgeDerivatives2D) { check_point_edge_derivatives<2>(); }
+TEST(ContactDistance, PointEdgeDerivatives3D) { check_point_edge_derivatives<3>(); }
+
+TEST(ContactDistance, PointPointDerivatives) {
+  auto f = [](const Eigen::Matrix<double, 6, 1>& x) {
+    return point_point_distance2_derivatives<3>(x.segment<3>(0), x.segment<3>(3));
+  };
+  Eigen::Matrix<double, 6, 1> x;
+  x << 0.3, -0.2, 0.9, 1.1, 0.4, -0.7;
+  const FdErrors e = fd_check<6>(x, f, [](const auto&) { return true; });
+  EXPECT_LT(e.grad, 1e-6);
+  EXPECT_LT(e.hess, 1e-5);
+  EXPECT_DOUBLE_EQ(f(x).d2, point_point_distance2<3>(x.segment<3>(0), x.segment<3>(3)));
+}
+
+using X12 = Eigen::Matrix<double, 12, 1>;
+
+Distance2<12> pt_derivs(const X12& x) {
+  return point_triangle_distance2_derivatives(x.segment<3>(0), x.segment<3>(3), x.segment<3>(6), x.segment<3>(9));
+}
+PointTriangleCase pt_case(const X12& x) {
+  return point_triangle_case(x.segment<3>(0), x.segment<3>(3), x.segment<3>(6), x.segment<3>(9));
+}
+double pt_value(const X12& x) {
+  return point_triangle_distance2(x.segment<3>(0), x.segment<3>(3), x.segment<3>(6), x.segment<3>(9));
+}
+
+TEST(ContactDistance, PointTriangleDerivatives) {
+  // The seven region points on a general (rotated, scaled) triangle, then
+  // random configurations.
+  const Eigen::Matrix3d R = Eigen::AngleAxisd(-1.1, Vec<3>(0.3, -1, 2).normalized()).toRotationMatrix();
+  auto T = [&](const Vec<3>& y) -> Vec<3> { return R * Vec<3>(1.3 * y(0) + 0.4 * y(1), 0.9 * y(1), y(2)); };
+  std::vector<X12> xs;
+  for (const TriCase& k : triangle_cases()) {
+    X12 x;
+    x << T(k.p), T(v<3>(0, 0, 0)), T(v<3>(1, 0, 0)), T(v<3>(0, 1, 0));
+    EXPECT_EQ(pt_case(x), k.c);
+    xs.push_back(x);
+  }
+  std::mt19937 rng(21);
+  std::uniform_real_distribution<double> u(-1, 1);
+  for (int i = 0; i < 400; ++i) {
+    X12 x;
+    for (int k = 0; k < 12; ++k) x(k) = u(rng);
+    x.segment<3>(0) *= 1.5;
+    xs.push_back(x);
+  }
+  FdErrors worst[7];
+  int tested[7] = {};
+  for (size_t i = 0; i < xs.size(); ++i) {
+    const PointTriangleCase c = pt_case(xs[i]);
+    const auto same = [&](const X12& y) { return pt_case(y) == c; };
+    bool inside = true;
+    for (int j = 0; j < 12 && i >= 7; ++j)
+      for (double sgn : {-1.0, 1.0}) {
+        X12 y = xs[i];
+        y(j) += sgn * 1e-6 * (1 + xs[i].lpNorm<Eigen::Infinity>());
+        inside = inside && same(y);
+      }
+    if (!inside) continue;
+    const FdErrors e = fd_check<12>(xs[i], pt_derivs, same);
+    const int k = static_cast<int>(c);
+    ++tested[k];
+    worst[k].grad = std::max(worst[k].grad, e.grad);
+    worst[k].hess = std::max(worst[k].hess, e.hess);
+    EXPECT_EQ(pt_derivs(xs[i]).d2, pt_value(xs[i]));
+  }
+  for (int k = 0; k < 7; ++k) {
+    EXPECT_GT(tested[k], 1) << "case " << k;
+    EXPECT_LT(worst[k].grad, 1e-6) << "case " << k;
+    EXPECT_LT(worst[k].hess, 1e-5) << "case " << k;
+    std::printf("point-triangle case %d: %d configurations, worst rel. error grad %.2e hess %.2e\n", k, tested[k],
+                worst[k].grad, worst[k].hess);
+  }
+}
+
+// Collinear triangles: the derivatives are those of the nearest edge's
+// point-edge case, mapped into the 12-vector (p, t0, t1, t2).
+TEST(ContactDistance, PointTriangleDegenerateDerivatives) {
+  const Vec<3> a(0, 0, 0), b(1, 0, 0), c(2, 0, 0);
+  // On a collinear triangle the long edge contains the short ones, so two
+  // edges tie; the first in the order E01, E12, E20 is reported.
+  // t = (a, b, c): p over x = 0.3 is nearest to E01 (= E20), over x = 1.6 to
+  // E12 (= E20); beyond c it is the vertex t2.
+  struct Case {
+    Vec<3> p;
+    PointTriangleCase c;
+    int slot[3];  // triangle stencil slots of the edge stencil (p, ea, eb)
+    Vec<3> ea, eb;
+  };
+  const Case cases[] = {
+      {Vec<3>(0.3, 0.7, 0.4), PointTriangleCase::P_E01, {0, 1, 2}, a, b},
+      {Vec<3>(1.6, -0.2, 0.5), PointTriangleCase::P_E12, {0, 2, 3}, b, c},
+      {Vec<3>(2.5, 0.1, 0.2), PointTriangleCase::P_T2, {0, 2, 3}, b, c},
+  };
+  for (const Case& k : cases) {
+    X12 x;
+    x << k.p, a, b, c;
+    EXPECT_EQ(pt_case(x), k.c);
+    const Distance2<12> d = pt_derivs(x);
+    const Distance2<9> e = point_edge_distance2_derivatives<3>(k.p, k.ea, k.eb);
+    EXPECT_DOUBLE_EQ(d.d2, e.d2);
+    Distance2<12> m;  // the edge derivatives scattered into (p, t0, t1, t2)
+    m.grad.setZero();
+    m.hess.setZero();
+    for (int i = 0; i < 3; ++i) {
+      m.grad.segment<3>(3 * k.slot[i]) = e.grad.segment<3>(3 * i);
+      for (int j = 0; j < 3; ++j) m.hess.block<3, 3>(3 * k.slot[i], 3 * k.slot[j]) = e.hess.block<3, 3>(3 * i, 3 * j);
+    }
+    EXPECT_LT((d.grad - m.grad).norm(), 1e-14);
+    EXPECT_LT((d.hess - m.hess).norm(), 1e-13);
+  }
+  // Nearly degenerate triangles and edges: finite derivatives.
+  for (double hgt : {1e-6, 1e-9, 1e-14, 0.0}) {
+    X12 y;
+    y << Vec<3>(0.5, 1e-7, 1e-7), a, b, Vec<3>(0.5, hgt, 0);
+    const Distance2<12> dy = pt_derivs(y);
+    EXPECT_TRUE(std::isfinite(dy.d2) && dy.grad.allFinite() && dy.hess.allFinite()) << hgt;
+    const Distance2<9> de = point_edge_distance2_derivatives<3>(Vec<3>(0.5, 1, 0), a, a + Vec<3>(hgt, 0, 0));
+    EXPECT_TRUE(std::isfinite(de.d2) && de.grad.allFinite() && de.hess.allFinite()) << hgt;
   }
 }
 
