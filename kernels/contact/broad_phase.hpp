@@ -257,7 +257,7 @@ class SpatialHash {
       count_entries(entries, over);
       if (over <= kMaxOversize && entries <= kEntriesPerBox * n) break;
     }
-    if (entries > INT_MAX) throw std::overflow_error("SpatialHash: too many (box, cell) entries");
+    if (entries > (LO(1) << 30)) throw std::overflow_error("SpatialHash: more than 2^30 (box, cell) entries");
     LO buckets = 1;
     while (buckets < entries) buckets *= 2;
     t_.grid.mask = static_cast<std::uint64_t>(buckets - 1);
