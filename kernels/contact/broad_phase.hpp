@@ -23,7 +23,7 @@
 //   pad the facets by dhat and the particles by 0 (or both by dhat/2).
 //   simplex_boxes needs explicit <dim, k> when `nodes` is a non-const View.
 //
-// Cell size h: a power-of-two multiple of the scene extent L at or above the
+// Cell size h: the scene extent L times a power of two, at or above the
 // median (over non-degenerate boxes) of the largest box side, from a 64-bin
 // log2 histogram, so a median box spans at most 2 cells per axis; h >= L/2^20
 // (cell keys fit in 64 bits). A box covering more than 4^dim cells is
