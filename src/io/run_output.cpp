@@ -12,7 +12,8 @@ const std::vector<std::string>& diagnostics_columns() {
   static const std::vector<std::string> cols = {
       "step", "time", "dt", "kinetic", "elastic", "potential", "total_energy", "momentum_x",
       "momentum_y", "momentum_z", "newton_iters", "linear_iters", "min_J", "assembly_s", "solve_s",
-      "step_s", "active_grid_nodes"};
+      "step_s", "active_grid_nodes", "contact_pairs", "min_distance", "barrier_energy", "friction_iters",
+      "ccd_alpha_min", "contact_force_x", "contact_force_y", "contact_force_z"};
   return cols;
 }
 
@@ -20,7 +21,10 @@ std::vector<double> diagnostics_row(const StepReport& r) {
   return {static_cast<double>(r.step), r.time, r.dt, r.kinetic, r.elastic, r.potential,
           r.total_energy(), r.momentum[0], r.momentum[1], r.momentum[2],
           static_cast<double>(r.newton.iterations), static_cast<double>(r.newton.linear_iterations),
-          r.min_J, r.newton.assembly_s, r.newton.solve_s, r.step_s, static_cast<double>(r.active_grid_nodes)};
+          r.min_J, r.newton.assembly_s, r.newton.solve_s, r.step_s, static_cast<double>(r.active_grid_nodes),
+          static_cast<double>(r.contact_pairs), r.min_distance, r.barrier_energy,
+          static_cast<double>(r.friction_iters), r.ccd_alpha_min, r.contact_force[0], r.contact_force[1],
+          r.contact_force[2]};
 }
 
 namespace {
@@ -35,7 +39,7 @@ RunOutput<dim>::RunOutput(const std::string& dir, const Scene& scene, const Simu
     : dir_(prepare_dir(dir)),
       h5_(dir + "/bfemp.h5"),
       xdmf_(dir + "/bfemp.xdmf", "bfemp.h5"),
-      csv_(dir + "/diagnostics.csv", diagnostics_columns(), {"step", "newton_iters", "linear_iters", "active_grid_nodes"}) {
+      csv_(dir + "/diagnostics.csv", diagnostics_columns(), {"step", "newton_iters", "linear_iters", "active_grid_nodes", "contact_pairs", "friction_iters"}) {
   std::ostringstream yaml;
   yaml << std::showpoint;
   Teuchos::writeParameterListToYamlOStream(scene.params, yaml);
@@ -91,6 +95,14 @@ void RunOutput<dim>::write_frame(const Simulation<dim>& sim) {
     h5_.write_array("particle_von_mises", pvmh.data(), np, 1);
     h5_.write_array("particle_J", pJh.data(), np, 1);
     h5_.write_array("particle_body", body.data(), np, 1);
+    const auto* contact = sim.contact();
+    if (contact && contact->particle_forces().extent(0) == np * dim) {
+      auto f = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), contact->particle_forces());
+      h5_.write_array("particle_contact_force", f.data(), np, dim);
+    } else if (contact) {
+      const std::vector<double> zero(np * dim, 0.0);  // frame 0: no step solved yet
+      h5_.write_array("particle_contact_force", zero.data(), np, dim);
+    }
     XdmfGrid g;
     g.name = "particles";
     g.group = Hdf5FrameWriter::frame_group_name(frame_);
@@ -102,6 +114,7 @@ void RunOutput<dim>::write_frame(const Simulation<dim>& sim) {
                          {"von_mises", "particle_von_mises", 1},
                          {"J", "particle_J", 1},
                          {"body", "particle_body", 1, true}};
+    if (contact) g.node_attributes.push_back({"contact_force", "particle_contact_force", dim});
     frame.grids.push_back(g);
   }
   h5_.end_frame();

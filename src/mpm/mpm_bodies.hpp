@@ -19,6 +19,10 @@ struct MpmSetup {
   Particles<dim> particles;
   TransferScheme scheme = TransferScheme::APIC;
   std::vector<std::string> body_names;
+  // A particle whose stencil leaves the grid: false: an error naming the
+  // particle and step; true: the grid grows by whole cells before the step
+  // (scene key 'MPM/when particles leave: extend').
+  bool extend_domain = false;
 };
 
 // MPM elasticity: deformation stencils of the particles; the graph couplings
@@ -39,7 +43,9 @@ class MpmBodies {
   // Activates the grid for this step's particles, P2G, builds the stencils.
   // Returns the number of active nodes (system nodes first .. first+count-1).
   // Throws std::runtime_error naming the particle and step when a particle's
-  // stencil leaves the grid domain.
+  // stencil leaves the grid domain, unless extend_domain: then the grid grows
+  // (origin and n_cells by whole cells, a quarter of the axis' cells or 2 more
+  // on each side that grows) to cover every particle.
   LO begin_step(LO first, long step);
   // Grid x^n (node positions), v^n = (m v)/m, and per-DOF mass into system
   // vectors at the active nodes.
@@ -54,6 +60,9 @@ class MpmBodies {
   const GridSpec<dim>& grid() const { return setup_.grid; }
   TransferScheme scheme() const { return setup_.scheme; }
   LO active_nodes() const { return active_; }
+  int domain_extensions() const { return extensions_; }  // times the grid grew
+  // System node of each grid node this step (-1: inactive).
+  Kokkos::View<const LO*, MemSpace> system_node() const { return system_node_; }
 
   // Particle diagnostics: kinetic, elastic (sum V0 psi(F_p)), gravity potential,
   // linear momentum, angular momentum about the origin (z; APIC adds the
@@ -75,6 +84,7 @@ class MpmBodies {
   DeformationStencils<dim, ns> stencils_;
   std::unique_ptr<MpmElasticityTerm<dim>> term_;
   LO first_ = 0, active_ = 0;
+  int extensions_ = 0;
 };
 
 }  // namespace bfemp

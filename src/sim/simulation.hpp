@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "fem/fem_mesh.hpp"
+#include "contact/contact.hpp"
 #include "fem/prescribed_motion.hpp"
 #include "mpm/level_set.hpp"
 #include "mpm/mpm_bodies.hpp"
@@ -27,6 +28,7 @@ struct SimulationSetup {
   std::vector<PrescribedMotion> motions;                // node ids are global FEM ids
   std::optional<MpmSetup<dim>> mpm;                     // MPM particles and grid
   std::vector<LevelSet> level_sets;                     // grid boundaries (MPM)
+  std::optional<ContactParams> contact;                 // MPM-FEM barrier contact
   TimeIntegrator integrator = TimeIntegrator::backward_euler();
   std::array<double, 3> gravity{0, 0, 0};
   double dt = 1e-3;
@@ -43,6 +45,13 @@ struct StepReport {
   NewtonStats newton;
   double min_J = 0;
   long active_grid_nodes = 0;
+  // Contact (zero without contact): pairs with d < dhat, their smallest
+  // distance, B(x), outer friction iterations, the smallest CCD step bound,
+  // the contact force on the reported FEM body.
+  long contact_pairs = 0;
+  double min_distance = 0, barrier_energy = 0, ccd_alpha_min = 0;
+  int friction_iters = 0;
+  std::array<double, 3> contact_force{0, 0, 0};
   double step_s = 0;
   double total_energy() const { return kinetic + elastic + potential; }
 };
@@ -62,6 +71,7 @@ class Simulation {
   MpmBodies<dim>* mpm() { return mpm_.get(); }
   const MpmBodies<dim>* mpm() const { return mpm_.get(); }
   NewtonSolver<dim>& newton() { return *newton_; }
+  const Contact<dim>* contact() const { return contact_.get(); }
   // FEM node-interleaved state; tests may set initial velocities before step().
   Kokkos::View<double*, MemSpace> positions() const { return x_; }
   Kokkos::View<double*, MemSpace> velocities() const { return v_; }
@@ -75,12 +85,15 @@ class Simulation {
   struct System;
   void apply_prescribed_targets(double t, Kokkos::View<double*, MemSpace> target) const;
   void prescribed_velocities(double t1);
+  NewtonStats minimize_with_friction(const IncrementalPotential& ip, Kokkos::View<double*, MemSpace> x,
+                                     Kokkos::View<double*, MemSpace> x_ref, double s, int& iterations);
 
   SimulationSetup<dim> setup_;
   FemMesh<dim> mesh_;
   std::unique_ptr<DeformationTerm<dim, dim + 1>> elasticity_;
   std::unique_ptr<MpmBodies<dim>> mpm_;
   std::unique_ptr<NewtonSolver<dim>> newton_;
+  std::unique_ptr<Contact<dim>> contact_;
   std::unique_ptr<System> sys_;
   LevelSetList level_sets_;
   Kokkos::View<double*, MemSpace> x_, v_, a_, mass_, initial_position_;

@@ -1,0 +1,165 @@
+#pragma once
+// One contact pair: an MPM particle q and an FEM boundary primitive (a node, an
+// edge or a triangle with nv = 1, 2, 3 vertices). Local variables are the
+// particle position and the vertex positions, stacked: L = (1 + nv) * dim.
+// The particle position is linear in the grid DOFs (paper Eq. 29):
+//   x_q = sum_a w_qa x_{n(q,a)},   w the B-spline weights at x_q^n,
+// so a local gradient g and (PSD) Hessian H reach the system as W^T g and
+// W^T H W, where W maps the expanded DOFs (3^dim grid nodes, nv vertices) to
+// the local ones. Couplings to prescribed DOFs go to the right-hand side
+// (rhs(free) -= H(free, prescribed) dx_prescribed), as in deformation_assemble.
+#include <Kokkos_Core.hpp>
+#include <cmath>
+#include <type_traits>
+
+#include "kernels/contact/barrier.hpp"
+#include "kernels/contact/distance.hpp"
+#include "mpm/bspline.hpp"
+
+namespace bfemp {
+
+// Per step: the particles' interpolation stencils into the system DOFs, and
+// their contact weights omega_q (paper §4.2: 2 sqrt(V0/pi) in 2D,
+// pi (3 V0 / (4 pi))^(2/3) in 3D).
+template <int dim>
+struct ParticleStencils {
+  static constexpr int ns = bspline_stencil_size<dim>;
+  Kokkos::View<LO* [ns], MemSpace> nodes;  // system node ids
+  Kokkos::View<double* [ns], MemSpace> w;  // weights, sum 1
+  Kokkos::View<double*, MemSpace> omega;   // m (2D) or m^2 (3D)
+  Kokkos::View<int*, MemSpace> body;       // MPM body index
+  LO size() const { return static_cast<LO>(omega.extent(0)); }
+};
+
+template <int dim>
+KOKKOS_INLINE_FUNCTION double particle_contact_weight(double volume0) {
+  if constexpr (dim == 2) return 2.0 * std::sqrt(volume0 / M_PI);
+  else return M_PI * std::pow(3.0 * volume0 / (4.0 * M_PI), 2.0 / 3.0);
+}
+
+// x_q = sum_a w_a x_{n_a} for every particle (node-interleaved output).
+template <int dim>
+void interpolate_particles(const ParticleStencils<dim>& ps, Kokkos::View<const double*, MemSpace> x,
+                           Kokkos::View<double*, MemSpace> xq) {
+  Kokkos::parallel_for(
+      "contact_interpolate", Kokkos::RangePolicy<ExecSpace>(0, ps.size()), KOKKOS_LAMBDA(const LO q) {
+        for (int c = 0; c < dim; ++c) {
+          double s = 0;
+          for (int a = 0; a < ParticleStencils<dim>::ns; ++a) s += ps.w(q, a) * x(ps.nodes(q, a) * dim + c);
+          xq(q * dim + c) = s;
+        }
+      });
+}
+
+template <int dim>
+KOKKOS_INLINE_FUNCTION Vec<dim> load_vec(const Kokkos::View<const double*, MemSpace>& x, LO node) {
+  Vec<dim> v;
+  for (int c = 0; c < dim; ++c) v(c) = x(node * dim + c);
+  return v;
+}
+
+// Squared distance of the pair's stencil with derivatives (nv = 1, 2, 3).
+template <int dim, int nv>
+KOKKOS_INLINE_FUNCTION Distance2<(1 + nv) * dim> stencil_distance2(const Vec<dim>& p, const Vec<dim>* v) {
+  if constexpr (nv == 1) return point_point_distance2_derivatives<dim>(p, v[0]);
+  else if constexpr (nv == 2) return point_edge_distance2_derivatives<dim>(p, v[0], v[1]);
+  else return point_triangle_distance2_derivatives(p, v[0], v[1], v[2]);
+}
+
+template <int dim, int nv>
+KOKKOS_INLINE_FUNCTION double stencil_distance2_value(const Vec<dim>& p, const Vec<dim>* v) {
+  if constexpr (nv == 1) return point_point_distance2<dim>(p, v[0]);
+  else if constexpr (nv == 2) return point_edge_distance2<dim>(p, v[0], v[1]);
+  else return point_triangle_distance2(p, v[0], v[1], v[2]);
+}
+
+// Barrier b(d) of a pair as a function of s = d^2, with gradient and Hessian
+// in the local variables: db/ds = b'/(2d), d2b/ds2 = (b'' - b'/d) / (4 s).
+template <int L>
+KOKKOS_INLINE_FUNCTION void barrier_of_distance2(const Distance2<L>& s, double dhat, double kappa, double w,
+                                                 Eigen::Matrix<double, L, 1>& g, SquareMat<L>& H) {
+  const double d = std::sqrt(s.d2);
+  const double b1 = barrier_first_derivative(d, dhat, kappa);
+  const double b2 = barrier_second_derivative(d, dhat, kappa);
+  const double dbds = b1 / (2.0 * d);
+  const double d2bds2 = (b2 - b1 / d) / (4.0 * s.d2);
+  g = (w * dbds) * s.grad;
+  H = (w * d2bds2) * (s.grad * s.grad.transpose()) + (w * dbds) * s.hess;
+}
+
+// Expanded DOF r of a pair (grid stencil nodes first, then the vertices).
+template <int dim>
+struct PairDofs {
+  static constexpr int ns = bspline_stencil_size<dim>;
+  LO node[ns + dim];  // system nodes: ns grid nodes, then up to dim vertices
+  double w[ns];
+  int nv;
+  KOKKOS_INLINE_FUNCTION int expanded_nodes() const { return ns + nv; }
+};
+
+// Calls f(std::integral_constant<int, nv>) for a primitive with nv vertices.
+template <int dim, class F>
+KOKKOS_INLINE_FUNCTION void dispatch_nv(int nv, const F& f) {
+  if (nv == 1) f(std::integral_constant<int, 1>{});
+  else if (nv == 2) f(std::integral_constant<int, 2>{});
+  else if constexpr (dim == 3) f(std::integral_constant<int, 3>{});
+}
+
+// The pair's expanded DOFs: particle q's stencil, then primitive j's vertices.
+template <int dim, class Prims>
+KOKKOS_INLINE_FUNCTION void fill_pair_dofs(const ParticleStencils<dim>& ps, const Prims& prims, LO q, LO j, int nv,
+                                           PairDofs<dim>& pd) {
+  constexpr int ns = ParticleStencils<dim>::ns;
+  for (int a = 0; a < ns; ++a) {
+    pd.node[a] = ps.nodes(q, a);
+    pd.w[a] = ps.w(q, a);
+  }
+  for (int i = 0; i < nv; ++i) pd.node[ns + i] = prims.nodes(j, i);
+  pd.nv = nv;
+}
+
+// Adds the pair's local gradient (grad += W^T g) and, when `A` is given, its
+// local Hessian W^T H W on free rows; prescribed columns go to rhs.
+template <int dim, int L, class LocalMatrix>
+KOKKOS_INLINE_FUNCTION void scatter_pair(const PairDofs<dim>& pd, const Eigen::Matrix<double, L, 1>& g,
+                                         const SquareMat<L>* H, Kokkos::View<double*, MemSpace> grad,
+                                         const LocalMatrix* A, const Kokkos::View<const int*, MemSpace>& prescribed,
+                                         const Kokkos::View<const double*, MemSpace>& dx_prescribed,
+                                         const Kokkos::View<double*, MemSpace>& rhs) {
+  constexpr int ns = PairDofs<dim>::ns;
+  constexpr int maxn = (ns + dim) * dim;
+  const int ne = pd.expanded_nodes();
+  // Local block of expanded node e and its weight (grid nodes: the particle
+  // block scaled by w; vertices: their own block).
+  auto block = [&](int e) { return e < ns ? 0 : e - ns + 1; };
+  auto weight = [&](int e) { return e < ns ? pd.w[e] : 1.0; };
+  for (int e = 0; e < ne; ++e)
+    for (int c = 0; c < dim; ++c) Kokkos::atomic_add(&grad(pd.node[e] * dim + c), weight(e) * g(block(e) * dim + c));
+  if (!A) return;
+  LO cols[maxn];
+  double vals[maxn];
+  for (int e = 0; e < ne; ++e)
+    for (int c = 0; c < dim; ++c) {
+      const LO row = pd.node[e] * dim + c;
+      if (prescribed(row)) continue;
+      const int lr = block(e) * dim + c;
+      int nc = 0;
+      double rhs_r = 0;
+      for (int f = 0; f < ne; ++f)
+        for (int k = 0; k < dim; ++k) {
+          const LO col = pd.node[f] * dim + k;
+          const double h = weight(e) * weight(f) * (*H)(lr, block(f) * dim + k);
+          if (prescribed(col)) {
+            rhs_r -= h * dx_prescribed(col);
+          } else {
+            cols[nc] = col;
+            vals[nc] = h;
+            ++nc;
+          }
+        }
+      A->sumIntoValues(row, cols, nc, vals, false, true);
+      if (rhs_r != 0) Kokkos::atomic_add(&rhs(row), rhs_r);
+    }
+}
+
+}  // namespace bfemp

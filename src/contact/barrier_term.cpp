@@ -1,0 +1,282 @@
+#include "contact/barrier_term.hpp"
+
+#include <algorithm>
+#include <limits>
+#include <type_traits>
+
+#include "contact/pair_couplings.hpp"
+#include "kernels/contact/ccd.hpp"
+#include "materials/psd_projection.hpp"
+
+namespace bfemp {
+
+namespace {
+
+constexpr double kCcdStepMax = 1.0 / 0.9;  // the solver takes 0.9 of the bound, capped at 1
+
+}  // namespace
+
+template <int dim>
+BarrierTerm<dim>::BarrierTerm(BoundaryPrimitives<dim> prims, double dhat, double kappa)
+    : prims_(prims), dhat_(dhat), kappa_(kappa), ccd_min_(std::numeric_limits<double>::infinity()) {}
+
+template <int dim>
+void BarrierTerm<dim>::begin_step(const ParticleStencils<dim>& ps, ConstDofView x) {
+  ps_ = ps;
+  const std::size_t n = static_cast<std::size_t>(ps.size()) * dim;
+  if (xq_.extent(0) != n) {
+    xq_ = Kokkos::View<double*, MemSpace>("contact_xq", n);
+    dq_ = Kokkos::View<double*, MemSpace>("contact_dq", n);
+  }
+  find_pairs(x, ConstDofView());
+  auto pairs = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), pairs_);
+  graph_keys_.clear();
+  const long long np = prims_.size();
+  for (LO k = 0; k < n_pairs_; ++k) graph_keys_.push_back(pairs(k, 0) * np + pairs(k, 1));
+  std::sort(graph_keys_.begin(), graph_keys_.end());
+  graph_keys_dev_ = Kokkos::View<long long*, MemSpace>("contact_graph_keys", graph_keys_.size());
+  Kokkos::deep_copy(graph_keys_dev_, Kokkos::View<const long long*, Kokkos::HostSpace>(graph_keys_.data(), graph_keys_.size()));
+}
+
+template <int dim>
+void BarrierTerm<dim>::find_pairs(ConstDofView x, ConstDofView p) const {
+  const bool moving = p.extent(0) > 0;
+  interpolate_particles(ps_, x, xq_);
+  if (moving) interpolate_particles(ps_, p, dq_);
+  point_boxes<dim>(xq_, moving ? ConstDofView(dq_) : ConstDofView(), 0.0, particle_boxes_);
+  simplex_boxes<dim, dim>(prims_.nodes, x, p, dhat_, prim_boxes_);
+  hash_.build(prim_boxes_);
+  n_pairs_ = prims_.size() > 0 && ps_.size() > 0 ? hash_.query(particle_boxes_, pairs_) : 0;
+}
+
+template <int dim>
+bool BarrierTerm<dim>::update(ConstDofView x) const {
+  find_pairs(x, ConstDofView());
+  const auto keys = graph_keys_dev_;
+  const auto pairs = pairs_;
+  const long long np = prims_.size();
+  const long long nk = static_cast<long long>(keys.extent(0));
+  LO missing = 0;
+  Kokkos::parallel_reduce(
+      "contact_graph_check", Kokkos::RangePolicy<ExecSpace>(0, n_pairs_),
+      KOKKOS_LAMBDA(const LO k, LO& acc) {
+        const long long key = pairs(k, 0) * np + pairs(k, 1);
+        long long lo = 0, hi = nk;  // lower bound
+        while (lo < hi) {
+          const long long mid = (lo + hi) / 2;
+          if (keys(mid) < key) lo = mid + 1;
+          else hi = mid;
+        }
+        if (lo == nk || keys(lo) != key) ++acc;
+      },
+      missing);
+  if (missing == 0) return false;
+  auto hp = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), pairs_);
+  for (LO k = 0; k < n_pairs_; ++k) graph_keys_.push_back(hp(k, 0) * np + hp(k, 1));
+  std::sort(graph_keys_.begin(), graph_keys_.end());
+  graph_keys_.erase(std::unique(graph_keys_.begin(), graph_keys_.end()), graph_keys_.end());
+  graph_keys_dev_ = Kokkos::View<long long*, MemSpace>("contact_graph_keys", graph_keys_.size());
+  Kokkos::deep_copy(graph_keys_dev_, Kokkos::View<const long long*, Kokkos::HostSpace>(graph_keys_.data(), graph_keys_.size()));
+  return true;
+}
+
+template <int dim>
+void BarrierTerm<dim>::prepare_direction(ConstDofView x, ConstDofView p) const {
+  find_pairs(x, p);
+}
+
+template <int dim>
+void BarrierTerm<dim>::add_couplings(std::vector<long long>& keys, LO n_nodes) const {
+  auto pn = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), ps_.nodes);
+  auto vn = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), prims_.nodes);
+  auto vc = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), prims_.count);
+  const long long np = prims_.size();
+  LO last_q = -1;  // keys are sorted by particle
+  for (long long key : graph_keys_) {
+    const LO q = static_cast<LO>(key / np);
+    add_pair_couplings(pn, vn, vc, q, static_cast<LO>(key % np), n_nodes, q != last_q, keys);
+    last_q = q;
+  }
+}
+
+template <int dim>
+double BarrierTerm<dim>::energy(ConstDofView x) const {
+  if (n_pairs_ == 0) return 0.0;
+  interpolate_particles(ps_, x, xq_);
+  const auto pairs = pairs_;
+  const auto prims = prims_;
+  const auto ps = ps_;
+  const ConstDofView xq = xq_;
+  const double dhat = dhat_, kappa = kappa_;
+  double e = 0;
+  Kokkos::parallel_reduce(
+      "barrier_energy", Kokkos::RangePolicy<ExecSpace>(0, n_pairs_),
+      KOKKOS_LAMBDA(const LO k, double& acc) {
+        const LO q = pairs(k, 0), j = pairs(k, 1);
+        dispatch_nv<dim>(prims.count(j), [&](auto NV) {
+          constexpr int nv = decltype(NV)::value;
+          Vec<dim> v[nv];
+          for (int i = 0; i < nv; ++i) v[i] = load_vec<dim>(x, prims.nodes(j, i));
+          const double d2 = stencil_distance2_value<dim, nv>(load_vec<dim>(xq, q), v);
+          if (d2 < dhat * dhat) acc += ps.omega(q) * prims.coef(j) * barrier(std::sqrt(d2), dhat, kappa);
+        });
+      },
+      e);
+  return e;
+}
+
+template <int dim>
+template <class Body>
+void BarrierTerm<dim>::for_each_pair(ConstDofView x, const Body& body) const {
+  interpolate_particles(ps_, x, xq_);
+  const auto pairs = pairs_;
+  const auto prims = prims_;
+  const auto ps = ps_;
+  const ConstDofView xq = xq_;
+  const double dhat = dhat_, kappa = kappa_;
+  Kokkos::parallel_for(
+      "barrier_pairs", Kokkos::RangePolicy<ExecSpace>(0, n_pairs_), KOKKOS_LAMBDA(const LO k) {
+        const LO q = pairs(k, 0), j = pairs(k, 1);
+        dispatch_nv<dim>(prims.count(j), [&](auto NV) {
+          constexpr int nv = decltype(NV)::value;
+          constexpr int L = (1 + nv) * dim;
+          Vec<dim> v[nv];
+          for (int i = 0; i < nv; ++i) v[i] = load_vec<dim>(x, prims.nodes(j, i));
+          const Vec<dim> p = load_vec<dim>(xq, q);
+          if (!(stencil_distance2_value<dim, nv>(p, v) < dhat * dhat)) return;
+          const Distance2<L> s = stencil_distance2<dim, nv>(p, v);
+          Eigen::Matrix<double, L, 1> g;
+          SquareMat<L> H;
+          barrier_of_distance2<L>(s, dhat, kappa, ps.omega(q) * prims.coef(j), g, H);
+          PairDofs<dim> pd;
+          fill_pair_dofs<dim>(ps, prims, q, j, nv, pd);
+          body(q, pd, g, H);
+        });
+      });
+}
+
+template <int dim>
+void BarrierTerm<dim>::gradient(ConstDofView x, double scale, DofView grad) const {
+  if (n_pairs_ == 0) return;
+  const MaskView none;
+  const ConstDofView dnone;
+  const DofView rnone;
+  for_each_pair(x, [=](LO, const PairDofs<dim>& pd, const auto& g, const auto&) {
+    constexpr int L = std::decay_t<decltype(g)>::RowsAtCompileTime;
+    const Eigen::Matrix<double, L, 1> gs = scale * g;
+    scatter_pair<dim, L, LocalMatrix>(pd, gs, nullptr, grad, nullptr, none, dnone, rnone);
+  });
+}
+
+template <int dim>
+void BarrierTerm<dim>::assemble(ConstDofView x, double scale, DofView grad, const LocalMatrix& A,
+                                MaskView prescribed, ConstDofView dx_prescribed, DofView rhs) const {
+  if (n_pairs_ == 0) return;
+  const bool project = project_;
+  for_each_pair(x, [=](LO, const PairDofs<dim>& pd, const auto& g, const auto& H) {
+    constexpr int L = std::decay_t<decltype(g)>::RowsAtCompileTime;
+    const Eigen::Matrix<double, L, 1> gs = scale * g;
+    SquareMat<L> Hs = scale * H;
+    if (project) project_psd<L>(Hs);
+    scatter_pair<dim, L, LocalMatrix>(pd, gs, &Hs, grad, &A, prescribed, dx_prescribed, rhs);
+  });
+}
+
+template <int dim>
+void BarrierTerm<dim>::particle_forces(ConstDofView x, DofView f) const {
+  Kokkos::deep_copy(f, 0.0);
+  if (n_pairs_ == 0) return;
+  for_each_pair(x, [=](LO q, const PairDofs<dim>&, const auto& g, const auto&) {
+    for (int c = 0; c < dim; ++c) Kokkos::atomic_add(&f(q * dim + c), -g(c));
+  });
+}
+
+template <int dim>
+double BarrierTerm<dim>::max_step(ConstDofView x, ConstDofView p) const {
+  if (n_pairs_ == 0) return std::numeric_limits<double>::infinity();
+  interpolate_particles(ps_, x, xq_);
+  interpolate_particles(ps_, p, dq_);
+  const auto pairs = pairs_;
+  const auto prims = prims_;
+  const ConstDofView xq = xq_, dq = dq_;
+  double tmin = kCcdStepMax;
+  Kokkos::parallel_reduce(
+      "barrier_ccd", Kokkos::RangePolicy<ExecSpace>(0, n_pairs_),
+      KOKKOS_LAMBDA(const LO k, double& acc) {
+        const LO q = pairs(k, 0), j = pairs(k, 1);
+        if (prims.count(j) != dim) return;  // nodes and edges lie on the facets
+        Vec<dim> v[dim], dv[dim];
+        for (int i = 0; i < dim; ++i) {
+          v[i] = load_vec<dim>(x, prims.nodes(j, i));
+          dv[i] = load_vec<dim>(p, prims.nodes(j, i));
+        }
+        const Vec<dim> xp = load_vec<dim>(xq, q), dp = load_vec<dim>(dq, q);
+        double t;
+        if constexpr (dim == 2) t = point_edge_ccd<2>(xp, v[0], v[1], dp, dv[0], dv[1], kCcdStepMax);
+        else t = point_triangle_ccd(xp, v[0], v[1], v[2], dp, dv[0], dv[1], dv[2], kCcdStepMax);
+        if (t < acc) acc = t;
+      },
+      Kokkos::Min<double>(tmin));
+  if (tmin >= kCcdStepMax) return std::numeric_limits<double>::infinity();
+  ccd_min_ = std::min(ccd_min_, tmin);
+  return tmin;
+}
+
+template <int dim>
+double BarrierTerm<dim>::take_ccd_min() const {
+  const double t = ccd_min_;
+  ccd_min_ = std::numeric_limits<double>::infinity();
+  return t;
+}
+
+template <int dim>
+typename BarrierTerm<dim>::ActivePairs BarrierTerm<dim>::active_pairs(ConstDofView x) const {
+  find_pairs(x, ConstDofView());
+  ActivePairs out;
+  Kokkos::View<double*, MemSpace> dist("contact_pair_distance", n_pairs_);
+  const auto pairs = pairs_;
+  const auto prims = prims_;
+  const auto ps = ps_;
+  const ConstDofView xq = xq_;
+  const double dhat = dhat_, kappa = kappa_;
+  Kokkos::parallel_for(
+      "contact_pair_distance", Kokkos::RangePolicy<ExecSpace>(0, n_pairs_), KOKKOS_LAMBDA(const LO k) {
+        const LO q = pairs(k, 0), j = pairs(k, 1);
+        dispatch_nv<dim>(prims.count(j), [&](auto NV) {
+          constexpr int nv = decltype(NV)::value;
+          Vec<dim> v[nv];
+          for (int i = 0; i < nv; ++i) v[i] = load_vec<dim>(x, prims.nodes(j, i));
+          dist(k) = std::sqrt(stencil_distance2_value<dim, nv>(load_vec<dim>(xq, q), v));
+        });
+      });
+  LO count = 0;
+  Kokkos::parallel_reduce(
+      "contact_active_count", Kokkos::RangePolicy<ExecSpace>(0, n_pairs_),
+      KOKKOS_LAMBDA(const LO k, LO& acc) { acc += dist(k) < dhat ? 1 : 0; }, count);
+  out.count = count;
+  out.pairs = Kokkos::View<LO* [2], MemSpace>("contact_active_pairs", count);
+  out.distance = Kokkos::View<double*, MemSpace>("contact_active_distance", count);
+  out.lambda = Kokkos::View<double*, MemSpace>("contact_active_lambda", count);
+  auto op = out.pairs;
+  auto od = out.distance;
+  auto ol = out.lambda;
+  Kokkos::parallel_scan(
+      "contact_active_compact", Kokkos::RangePolicy<ExecSpace>(0, n_pairs_),
+      KOKKOS_LAMBDA(const LO k, LO& offset, const bool final) {
+        if (!(dist(k) < dhat)) return;
+        if (final) {
+          const LO q = pairs(k, 0), j = pairs(k, 1);
+          op(offset, 0) = q;
+          op(offset, 1) = j;
+          od(offset) = dist(k);
+          ol(offset) = -ps.omega(q) * prims.coef(j) * barrier_first_derivative(dist(k), dhat, kappa);
+        }
+        ++offset;
+      });
+  return out;
+}
+
+template class BarrierTerm<2>;
+template class BarrierTerm<3>;
+
+}  // namespace bfemp

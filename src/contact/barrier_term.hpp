@@ -1,0 +1,77 @@
+#pragma once
+// The barrier contact energy between MPM particles and the FEM boundary
+// (paper Eqs. 28-32) as a term of the incremental potential:
+//   B(x) = sum_{pairs (q, j)} omega_q c_j b(d(x_q, primitive j), dhat)
+// over the candidate pairs of a spatial hash (primitives padded by dhat). The
+// pair set follows the Newton iterates: update(x) finds the pairs near x
+// before each assembly, prepare_direction(x, p) the pairs the segment
+// x + t p (t in [0, 1]) can reach, which serve the CCD step bound (max_step)
+// and the line-search energies. The system graph holds every pair seen in the
+// step; a pair outside it makes update() ask for a rebuild.
+#include <vector>
+
+#include "contact/boundary_primitives.hpp"
+#include "kernels/contact/broad_phase.hpp"
+#include "kernels/contact/contact_pair.hpp"
+#include "solver/energy_term.hpp"
+
+namespace bfemp {
+
+template <int dim>
+class BarrierTerm : public EnergyTerm<dim> {
+ public:
+  BarrierTerm(BoundaryPrimitives<dim> prims, double dhat, double kappa);
+  std::string name() const override { return "barrier contact"; }
+
+  // New step: particle stencils of this step, pairs near x^n (the graph's).
+  void begin_step(const ParticleStencils<dim>& ps, ConstDofView x);
+
+  void add_couplings(std::vector<long long>& keys, LO n_nodes) const override;
+  double energy(ConstDofView x) const override;
+  void gradient(ConstDofView x, double scale, DofView grad) const override;
+  void assemble(ConstDofView x, double scale, DofView grad, const LocalMatrix& A, MaskView prescribed,
+                ConstDofView dx_prescribed, DofView rhs) const override;
+  double max_step(ConstDofView x, ConstDofView p) const override;
+  bool update(ConstDofView x) const override;
+  void prepare_direction(ConstDofView x, ConstDofView p) const override;
+  void set_projection(bool project) { project_ = project; }  // false: exact Hessian (tests)
+
+  // Pairs (particle, primitive) near x with d < dhat: their distance and the
+  // normal force magnitude lambda = -omega c b'(d) (N in 3D, N/m in 2D).
+  struct ActivePairs {
+    Kokkos::View<LO* [2], MemSpace> pairs;
+    Kokkos::View<double*, MemSpace> distance, lambda;
+    LO count = 0;
+  };
+  ActivePairs active_pairs(ConstDofView x) const;
+  // Contact force on the particles (-dB/dx_q), node-interleaved per particle.
+  void particle_forces(ConstDofView x, DofView f) const;
+
+  // Smallest CCD bound returned since the last call (inf if none); resets.
+  double take_ccd_min() const;
+  const BoundaryPrimitives<dim>& primitives() const { return prims_; }
+  const ParticleStencils<dim>& particles() const { return ps_; }
+  double dhat() const { return dhat_; }
+  double kappa() const { return kappa_; }
+  LO candidate_pairs() const { return n_pairs_; }
+
+ private:
+  void find_pairs(ConstDofView x, ConstDofView p) const;  // p empty: static
+  template <class Body>
+  void for_each_pair(ConstDofView x, const Body& body) const;
+
+  BoundaryPrimitives<dim> prims_;
+  double dhat_, kappa_;
+  bool project_ = true;
+  ParticleStencils<dim> ps_;
+  mutable SpatialHash<dim> hash_;
+  mutable Boxes<dim> prim_boxes_, particle_boxes_;
+  mutable Kokkos::View<double*, MemSpace> xq_, dq_;
+  mutable Kokkos::View<LO* [2], MemSpace> pairs_;
+  mutable LO n_pairs_ = 0;
+  mutable std::vector<long long> graph_keys_;  // q * n_prims + j, sorted
+  mutable Kokkos::View<long long*, MemSpace> graph_keys_dev_;
+  mutable double ccd_min_;
+};
+
+}  // namespace bfemp

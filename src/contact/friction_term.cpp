@@ -1,0 +1,243 @@
+#include "contact/friction_term.hpp"
+
+#include <limits>
+#include <type_traits>
+
+#include "contact/pair_couplings.hpp"
+#include "kernels/contact/friction.hpp"
+
+namespace bfemp {
+
+template <int dim>
+FrictionTerm<dim>::FrictionTerm(const BarrierTerm<dim>& barrier, std::vector<double> mu, int n_fem_bodies,
+                                double eps_v)
+    : barrier_(barrier), n_fem_(n_fem_bodies), eps_v_(eps_v) {
+  mu_ = Kokkos::View<double*, MemSpace>("friction_mu", mu.size());
+  Kokkos::deep_copy(mu_, Kokkos::View<const double*, Kokkos::HostSpace>(mu.data(), mu.size()));
+}
+
+template <int dim>
+LO FrictionTerm<dim>::update_lagged(ConstDofView x, ConstDofView x_ref, double s, double dt) {
+  const auto act = barrier_.active_pairs(x);
+  const auto& ps = barrier_.particles();
+  const auto& prims = barrier_.primitives();
+  s_ = s;
+  eh_ = eps_v_ * dt;
+  x_ref_ = x_ref;
+  n_ = act.count;
+  pair_ = Kokkos::View<LO* [2], MemSpace>("friction_pairs", n_);
+  c_ = decltype(c_)("friction_c", n_);
+  T_ = decltype(T_)("friction_T", n_);
+  ml_ = Kokkos::View<double*, MemSpace>("friction_mu_lambda", n_);
+  const std::size_t nq = static_cast<std::size_t>(ps.size()) * dim;
+  if (xq_.extent(0) != nq) {
+    xq_ = Kokkos::View<double*, MemSpace>("friction_xq", nq);
+    xq_ref_ = Kokkos::View<double*, MemSpace>("friction_xq_ref", nq);
+  }
+  interpolate_particles(ps, x, xq_);
+  const ConstDofView xq = xq_;
+  auto pair = pair_;
+  auto c = c_;
+  auto T = T_;
+  auto ml = ml_;
+  const auto mu = mu_;
+  const int nf = n_fem_;
+  LO nonzero = 0;
+  Kokkos::parallel_reduce(
+      "friction_lag", Kokkos::RangePolicy<ExecSpace>(0, n_),
+      KOKKOS_LAMBDA(const LO k, LO& acc) {
+        const LO q = act.pairs(k, 0), j = act.pairs(k, 1);
+        pair(k, 0) = q;
+        pair(k, 1) = j;
+        const int nv = prims.count(j);
+        const Vec<dim> p = load_vec<dim>(xq, q);
+        Vec<dim> v[dim];
+        for (int i = 0; i < nv; ++i) v[i] = load_vec<dim>(x, prims.nodes(j, i));
+        double bary[dim] = {};
+        if (nv == 1) {
+          bary[0] = 1;
+        } else if (nv == 2) {
+          const double beta = point_edge_closest_parameter<dim>(p, v[0], v[1]);
+          bary[0] = 1 - beta;
+          bary[1] = beta;
+        } else if constexpr (dim == 3) {
+          const Vec<2> b = point_triangle_closest_barycentric(p, v[0], v[1], v[2]);
+          bary[0] = 1 - b(0) - b(1);
+          bary[1] = b(0);
+          bary[2] = b(1);
+        }
+        Vec<dim> closest = Vec<dim>::Zero();
+        for (int i = 0; i < nv; ++i) closest += bary[i] * v[i];
+        const Vec<dim> n = (p - closest).normalized();
+        const auto Tk = tangent_basis_of_normal<dim>(n);
+        for (int a = 0; a < dim; ++a)
+          for (int b = 0; b < dim - 1; ++b) T(k, a, b) = Tk(a, b);
+        c(k, 0) = 1.0;
+        for (int i = 0; i < dim; ++i) c(k, 1 + i) = i < nv ? -bary[i] : 0.0;
+        ml(k) = mu(ps.body(q) * nf + prims.body(j)) * act.lambda(k);
+        acc += ml(k) != 0 ? 1 : 0;
+      },
+      nonzero);
+  return nonzero;
+}
+
+template <int dim>
+void FrictionTerm<dim>::add_couplings(std::vector<long long>& keys, LO n_nodes) const {
+  const auto& ps = barrier_.particles();
+  const auto& prims = barrier_.primitives();
+  auto pn = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), ps.nodes);
+  auto vn = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), prims.nodes);
+  auto vc = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), prims.count);
+  auto pr = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), pair_);
+  for (LO k = 0; k < n_; ++k) add_pair_couplings(pn, vn, vc, pr(k, 0), pr(k, 1), n_nodes, true, keys);
+}
+
+// body(k, q, pd, u, Tk, ck): u the sliding displacement, per lagged pair.
+template <int dim>
+template <class Body>
+void FrictionTerm<dim>::for_each_pair(ConstDofView x, const Body& body) const {
+  const auto& ps = barrier_.particles();
+  interpolate_particles(ps, x, xq_);
+  interpolate_particles(ps, x_ref_, xq_ref_);
+  const ConstDofView xq = xq_, xr = xq_ref_, xref = x_ref_;
+  const auto prims = barrier_.primitives();
+  const auto psc = ps;
+  const auto pair = pair_;
+  const auto c = c_;
+  const auto T = T_;
+  const double s = s_;
+  Kokkos::parallel_for(
+      "friction_pairs", Kokkos::RangePolicy<ExecSpace>(0, n_), KOKKOS_LAMBDA(const LO k) {
+        const LO q = pair(k, 0), j = pair(k, 1);
+        const int nv = prims.count(j);
+        Eigen::Matrix<double, dim, dim - 1> Tk;
+        for (int a = 0; a < dim; ++a)
+          for (int b = 0; b < dim - 1; ++b) Tk(a, b) = T(k, a, b);
+        Vec<dim> rel = c(k, 0) * s * (load_vec<dim>(xq, q) - load_vec<dim>(xr, q));
+        for (int i = 0; i < nv; ++i) {
+          const LO n = prims.nodes(j, i);
+          rel += c(k, 1 + i) * s * (load_vec<dim>(x, n) - load_vec<dim>(xref, n));
+        }
+        const Eigen::Matrix<double, dim - 1, 1> u = Tk.transpose() * rel;
+        PairDofs<dim> pd;
+        fill_pair_dofs<dim>(psc, prims, q, j, nv, pd);
+        body(k, q, pd, u, Tk);
+      });
+}
+
+template <int dim>
+double FrictionTerm<dim>::energy(ConstDofView x) const {
+  if (n_ == 0) return 0.0;
+  const auto& ps = barrier_.particles();
+  interpolate_particles(ps, x, xq_);
+  interpolate_particles(ps, x_ref_, xq_ref_);
+  const ConstDofView xq = xq_, xr = xq_ref_, xref = x_ref_;
+  const auto prims = barrier_.primitives();
+  const auto pair = pair_;
+  const auto c = c_;
+  const auto T = T_;
+  const auto ml = ml_;
+  const double s = s_, eh = eh_;
+  double e = 0;
+  Kokkos::parallel_reduce(
+      "friction_energy", Kokkos::RangePolicy<ExecSpace>(0, n_),
+      KOKKOS_LAMBDA(const LO k, double& acc) {
+        const LO q = pair(k, 0), j = pair(k, 1);
+        Vec<dim> rel = c(k, 0) * s * (load_vec<dim>(xq, q) - load_vec<dim>(xr, q));
+        for (int i = 0; i < prims.count(j); ++i) {
+          const LO n = prims.nodes(j, i);
+          rel += c(k, 1 + i) * s * (load_vec<dim>(x, n) - load_vec<dim>(xref, n));
+        }
+        Eigen::Matrix<double, dim, dim - 1> Tk;
+        for (int a = 0; a < dim; ++a)
+          for (int b = 0; b < dim - 1; ++b) Tk(a, b) = T(k, a, b);
+        acc += ml(k) * friction_f0((Tk.transpose() * rel).norm(), eh);
+      },
+      e);
+  return e;
+}
+
+namespace {
+
+// Local gradient and Hessian of mu lambda f0(|u|) in the stacked positions
+// (particle, vertices): block i = s c_i T (f1/y) u; block (i, i') = s^2 c_i
+// c_i' T H_u T^T.
+template <int dim, int nv, class CV>
+KOKKOS_INLINE_FUNCTION void friction_local(const CV& c, LO k, double ml, double s, double eh,
+                                           const Eigen::Matrix<double, dim - 1, 1>& u,
+                                           const Eigen::Matrix<double, dim, dim - 1>& T,
+                                           Eigen::Matrix<double, (1 + nv) * dim, 1>& g,
+                                           SquareMat<(1 + nv) * dim>* H) {
+  const double y = u.norm();
+  const Vec<dim> f = ml * friction_f1_over_y(y, eh) * (T * u);
+  for (int i = 0; i <= nv; ++i) g.template segment<dim>(i * dim) = s * c(k, i) * f;
+  if (!H) return;
+  H->setZero();
+  if (!(ml > 0)) return;  // a compensation pair: its (negative) Hessian projects to zero
+  const Mat<dim> Hx = ml * s * s * (T * friction_f0_hessian<dim - 1>(u, eh) * T.transpose());
+  for (int i = 0; i <= nv; ++i)
+    for (int l = 0; l <= nv; ++l) H->template block<dim, dim>(i * dim, l * dim) = c(k, i) * c(k, l) * Hx;
+}
+
+}  // namespace
+
+template <int dim>
+void FrictionTerm<dim>::gradient(ConstDofView x, double scale, DofView grad) const {
+  if (n_ == 0) return;
+  const auto c = c_;
+  const auto ml = ml_;
+  const double s = s_, eh = eh_;
+  const MaskView none;
+  const ConstDofView dnone;
+  const DofView rnone;
+  for_each_pair(x, [=](LO k, LO, const PairDofs<dim>& pd, const auto& u, const auto& T) {
+    dispatch_nv<dim>(pd.nv, [&](auto NV) {
+      constexpr int nv = decltype(NV)::value;
+      constexpr int L = (1 + nv) * dim;
+      Eigen::Matrix<double, L, 1> g;
+      friction_local<dim, nv>(c, k, scale * ml(k), s, eh, u, T, g, static_cast<SquareMat<L>*>(nullptr));
+      scatter_pair<dim, L, LocalMatrix>(pd, g, nullptr, grad, nullptr, none, dnone, rnone);
+    });
+  });
+}
+
+template <int dim>
+void FrictionTerm<dim>::assemble(ConstDofView x, double scale, DofView grad, const LocalMatrix& A,
+                                 MaskView prescribed, ConstDofView dx_prescribed, DofView rhs) const {
+  if (n_ == 0) return;
+  const auto c = c_;
+  const auto ml = ml_;
+  const double s = s_, eh = eh_;
+  for_each_pair(x, [=](LO k, LO, const PairDofs<dim>& pd, const auto& u, const auto& T) {
+    dispatch_nv<dim>(pd.nv, [&](auto NV) {
+      constexpr int nv = decltype(NV)::value;
+      constexpr int L = (1 + nv) * dim;
+      Eigen::Matrix<double, L, 1> g;
+      SquareMat<L> H;
+      friction_local<dim, nv>(c, k, scale * ml(k), s, eh, u, T, g, &H);
+      scatter_pair<dim, L, LocalMatrix>(pd, g, &H, grad, &A, prescribed, dx_prescribed, rhs);
+    });
+  });
+}
+
+template <int dim>
+void FrictionTerm<dim>::add_particle_forces(ConstDofView x, DofView f) const {
+  if (n_ == 0) return;
+  const auto c = c_;
+  const auto ml = ml_;
+  const double s = s_, eh = eh_;
+  for_each_pair(x, [=](LO k, LO q, const PairDofs<dim>& pd, const auto& u, const auto& T) {
+    dispatch_nv<dim>(pd.nv, [&](auto NV) {
+      constexpr int nv = decltype(NV)::value;
+      constexpr int L = (1 + nv) * dim;
+      Eigen::Matrix<double, L, 1> g;
+      friction_local<dim, nv>(c, k, ml(k), s, eh, u, T, g, static_cast<SquareMat<L>*>(nullptr));
+      for (int d = 0; d < dim; ++d) Kokkos::atomic_add(&f(q * dim + d), -g(d));
+    });
+  });
+}
+
+template class FrictionTerm<2>;
+template class FrictionTerm<3>;
+
+}  // namespace bfemp

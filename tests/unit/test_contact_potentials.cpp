@@ -1,0 +1,206 @@
+// The contact potentials on the system DOFs (FEM nodes + active MPM grid
+// nodes): finite-difference checks of the barrier B (paper Eqs. 31-32, with
+// the duplicate compensation, exact Hessian) and of the lagged friction D
+// (Eq. 37) through the particles' B-spline weights (Eq. 29), in 2D and 3D;
+// the compensated sum reproduces the max form near a corner; the boundary
+// primitives' coefficients; particles inside an FEM body are found.
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "common/fd_check.hpp"
+#include "contact/contact.hpp"
+#include "kernels/contact/barrier.hpp"
+
+using namespace bfemp;
+
+namespace {
+
+// A unit square (2 triangles) or unit cube corner tet as the FEM body.
+template <int dim>
+MeshData fem_block() {
+  MeshData m;
+  m.dim = dim;
+  if constexpr (dim == 2) {
+    m.coords = {0, 0, 1, 0, 1, 1, 0, 1};
+    m.cells = {0, 1, 2, 0, 2, 3};
+  } else {
+    m.coords = {0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1};
+    m.cells = {0, 1, 2, 3};
+  }
+  return m;
+}
+
+template <int dim>
+struct ContactScene {
+  FemMesh<dim> mesh;
+  std::unique_ptr<MpmBodies<dim>> mpm;
+  std::unique_ptr<Contact<dim>> contact;
+  Kokkos::View<double*, MemSpace> x;
+  LO n_nodes = 0;
+};
+
+// FEM block and particles at `pts`; system x = FEM rest + grid x^n.
+template <int dim>
+ContactScene<dim> make_scene(const std::vector<Vec<dim>>& pts, ContactParams cp) {
+  ContactScene<dim> s;
+  MaterialParams mp;
+  mp.lame = lame_from_young(1e5, 0.3);
+  mp.density = 1000;
+  std::vector<FemBodyInput> bodies{{"fem", fem_block<dim>(), 0}};
+  s.mesh = build_fem_mesh<dim>(bodies, {mp});
+  MpmSetup<dim> m;
+  m.grid = grid_covering<dim>(Vec<dim>::Constant(-1.0), Vec<dim>::Constant(2.0), 0.1);
+  m.particles = allocate_particles<dim>(pts.size());
+  for (std::size_t q = 0; q < pts.size(); ++q) {
+    for (int d = 0; d < dim; ++d) m.particles.x(q, d) = pts[q](d);
+    m.particles.volume0(q) = std::pow(0.05, dim);
+    m.particles.mass(q) = 1.0;
+  }
+  m.body_names = {"mpm"};
+  s.mpm = std::make_unique<MpmBodies<dim>>(m, s.mesh.elements.materials);
+  const LO nF = s.mesh.num_nodes();
+  const LO nA = s.mpm->begin_step(nF, 1);
+  s.n_nodes = nF + nA;
+  s.x = Kokkos::View<double*, MemSpace>("x", s.n_nodes * dim);
+  Kokkos::View<double*, MemSpace> v("v", s.n_nodes * dim), mass("m", s.n_nodes * dim);
+  Kokkos::deep_copy(Kokkos::subview(s.x, std::make_pair(0, nF * dim)), s.mesh.rest_position);
+  s.mpm->fill_system(s.x, v, mass);
+  s.contact = std::make_unique<Contact<dim>>(s.mesh, cp);
+  s.contact->begin_step(*s.mpm, s.x);
+  return s;
+}
+
+template <int dim>
+void perturb(Kokkos::View<double*, MemSpace> x, double amp, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> u(-amp, amp);
+  for (std::size_t i = 0; i < x.extent(0); ++i) x(i) += u(rng);
+}
+
+ContactParams params(double dhat, double mu = 0.0, int n_mpm = 1) {
+  ContactParams cp;
+  cp.dhat = dhat;
+  cp.kappa = 1e3;
+  cp.eps_v = 1e-2;
+  if (mu > 0) cp.mu.assign(n_mpm, mu);
+  return cp;
+}
+
+}  // namespace
+
+TEST(ContactPrimitives, CompensationCoefficients) {
+  MaterialParams mp;
+  mp.lame = lame_from_young(1e5, 0.3);
+  {
+    std::vector<FemBodyInput> b{{"sq", fem_block<2>(), 0}};
+    const auto bp = boundary_primitives<2>(build_fem_mesh<2>(b, {mp}));
+    auto c = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), bp.count);
+    auto k = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), bp.coef);
+    int edges = 0, nodes = 0;
+    for (LO j = 0; j < bp.size(); ++j) {
+      if (c(j) == 2) { ++edges; EXPECT_EQ(k(j), 1.0); }
+      if (c(j) == 1) { ++nodes; EXPECT_EQ(k(j), -1.0); }  // eta = 2 on a closed polygon
+    }
+    EXPECT_EQ(edges, 4);  // the diagonal is interior
+    EXPECT_EQ(nodes, 4);
+  }
+  {
+    std::vector<FemBodyInput> b{{"tet", fem_block<3>(), 0}};
+    const auto bp = boundary_primitives<3>(build_fem_mesh<3>(b, {mp}));
+    auto c = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), bp.count);
+    auto k = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), bp.coef);
+    int tris = 0, edges = 0, nodes = 0;
+    for (LO j = 0; j < bp.size(); ++j) {
+      if (c(j) == 3) { ++tris; EXPECT_EQ(k(j), 1.0); }
+      if (c(j) == 2) { ++edges; EXPECT_EQ(k(j), -1.0); }  // eta_e = 2
+      if (c(j) == 1) { ++nodes; EXPECT_EQ(k(j), 1.0); }   // closed surface: c_v = 1
+    }
+    EXPECT_EQ(tris, 4);
+    EXPECT_EQ(edges, 6);
+    EXPECT_EQ(nodes, 4);
+  }
+}
+
+TEST(ContactPotentials, CompensatedSumEqualsTheClosestFeatureBarrier) {
+  const double dhat = 0.1;
+  // Above the top edge's interior, and in the vertex region of corner (1, 1).
+  const Vec<2> above(0.5, 1.04), corner(1.03, 1.02);
+  for (const Vec<2>& p : {above, corner}) {
+    auto s = make_scene<2>({p}, params(dhat));
+    const double d = p == above ? 0.04 : std::hypot(0.03, 0.02);
+    const double omega = particle_contact_weight<2>(std::pow(0.05, 2));
+    EXPECT_NEAR(s.contact->barrier()->energy(s.x), omega * barrier(d, dhat, 1e3), 1e-12 * omega * barrier(d, dhat, 1e3));
+  }
+}
+
+TEST(ContactPotentials, BarrierDerivatives2D) {
+  // Above an edge, near a corner (vertex compensation active) and beside the
+  // right edge.
+  auto s = make_scene<2>({Vec<2>(0.5, 1.03), Vec<2>(1.02, 1.03), Vec<2>(1.04, 0.4), Vec<2>(0.97, 1.06)},
+                         params(0.1));
+  perturb<2>(s.x, 2e-3, 3);
+  auto& barrier = const_cast<BarrierTerm<2>&>(*s.contact->barrier());
+  barrier.set_projection(false);
+  ASSERT_GT(barrier.energy(s.x), 0.0);
+  fixtures::check_energy_term<2>(barrier, s.n_nodes, s.x, 1e-7, 1e-5);
+}
+
+TEST(ContactPotentials, BarrierDerivatives3D) {
+  // Below the z = 0 face, beside the x = 0 face, near the edge on the x axis
+  // and near vertex 0 (edge and vertex compensation terms).
+  auto s = make_scene<3>({Vec<3>(0.2, 0.2, -0.03), Vec<3>(-0.04, 0.3, 0.2), Vec<3>(0.5, -0.03, -0.02),
+                          Vec<3>(-0.02, -0.03, -0.02)},
+                         params(0.1));
+  perturb<3>(s.x, 2e-3, 5);
+  auto& barrier = const_cast<BarrierTerm<3>&>(*s.contact->barrier());
+  barrier.set_projection(false);
+  ASSERT_GT(barrier.energy(s.x), 0.0);
+  fixtures::check_energy_term<3>(barrier, s.n_nodes, s.x, 1e-7, 1e-5);
+}
+
+template <int dim>
+void friction_case(const std::vector<Vec<dim>>& pts, double slide) {
+  auto s = make_scene<dim>(pts, params(0.1, 0.4));
+  perturb<dim>(s.x, 1e-3, 7);
+  Kokkos::View<double*, MemSpace> xref("xref", s.x.extent(0));
+  Kokkos::deep_copy(xref, s.x);
+  perturb<dim>(xref, slide, 9);  // the step's sliding displacement x - x_ref
+  auto* contact = s.contact.get();
+  ASSERT_TRUE(contact->has_friction());
+  ASSERT_GT(contact->update_friction(s.x, xref, 1.0, 1.0), 0);
+  const auto& friction = *contact->friction();
+  ASSERT_GT(friction.energy(s.x), 0.0);
+  fixtures::check_energy_term<dim>(friction, s.n_nodes, s.x, 1e-8, 1e-5);
+}
+
+// Particles over facet interiors only (no compensation pair within dhat, so
+// every lagged lambda is positive and the Hessian is exact). eps_v dt = 1e-2:
+// slides of 3e-3 stay in the static (mollified) branch; slides up to 2.5e-2
+// put some pairs in the sliding branch (whose 1D tangent Hessian is zero) and
+// keep others static.
+TEST(ContactPotentials, FrictionDerivatives2DStatic) {
+  friction_case<2>({Vec<2>(0.4, 1.03), Vec<2>(0.6, 1.05), Vec<2>(1.04, 0.5)}, 3e-3);
+}
+TEST(ContactPotentials, FrictionDerivatives2DStaticAndSliding) {
+  friction_case<2>({Vec<2>(0.4, 1.03), Vec<2>(0.6, 1.05), Vec<2>(1.04, 0.5), Vec<2>(0.3, 1.02)}, 2.5e-2);
+}
+TEST(ContactPotentials, FrictionDerivatives3D) {
+  friction_case<3>({Vec<3>(0.25, 0.25, -0.03), Vec<3>(0.3, 0.4, -0.05)}, 3e-3);
+  friction_case<3>({Vec<3>(0.25, 0.25, -0.03), Vec<3>(0.3, 0.4, -0.05)}, 5e-2);
+}
+
+TEST(ContactInitialCheck, RefusesAParticleInsideOrOnTheFemBody) {
+  auto ok = make_scene<2>({Vec<2>(0.5, 1.01)}, params(0.1));
+  EXPECT_NO_THROW(ok.contact->check_initial(ok.mpm->particles(), ok.mesh.rest_position));
+  for (const Vec<2>& p : {Vec<2>(0.5, 0.5), Vec<2>(0.5, 1.0), Vec<2>(1.0, 1.0)}) {
+    auto s = make_scene<2>({Vec<2>(-0.5, -0.5), p}, params(0.1));
+    try {
+      s.contact->check_initial(s.mpm->particles(), s.mesh.rest_position);
+      ADD_FAILURE() << "particle at (" << p.transpose() << ") accepted";
+    } catch (const std::invalid_argument& e) {
+      EXPECT_NE(std::string(e.what()).find("MPM particle 1"), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find("inside or on an FEM body"), std::string::npos) << e.what();
+    }
+  }
+}
