@@ -87,7 +87,61 @@ Scene finish(ParameterList raw, const std::string& path, const std::string& base
     const bool ok = dim == 2 ? (ppc == 1 || ppc == 4 || ppc == 9 || ppc == 16) : (ppc == 1 || ppc == 8 || ppc == 27);
     if (!ok) bad("MPM/particles per cell", std::to_string(ppc), dim == 2 ? "1, 4, 9 or 16" : "1, 8 or 27");
   }
+  const auto& c = raw.sublist("Contact");
+  for (const char* k : {"dhat", "kappa", "eps_v"})
+    if (!(c.get<double>(k) > 0)) bad(std::string("Contact/") + k, num(c.get<double>(k)), "a positive value");
+  if (!(c.get<double>("friction") >= 0)) bad("Contact/friction", num(c.get<double>("friction")), "mu >= 0");
+  if (c.get<int>("friction iterations") < 1)
+    bad("Contact/friction iterations", std::to_string(c.get<int>("friction iterations")), ">= 1");
+  const std::string fb = c.get<std::string>("force body");
+  if (!fb.empty() && !raw.sublist("FEM Bodies").isSublist(fb))
+    bad("Contact/force body", "'" + fb + "'", "the name of an FEM body");
   return s;
+}
+
+std::string trim(const std::string& t) {
+  const auto a = t.find_first_not_of(' '), b = t.find_last_not_of(' ');
+  return a == std::string::npos ? "" : t.substr(a, b - a + 1);
+}
+
+int index_of(const ParameterList& list, const std::string& name) {
+  int i = 0;
+  for (auto it = list.begin(); it != list.end(); ++it, ++i)
+    if (list.name(it) == name) return i;
+  return -1;
+}
+
+// Contact parameters; the friction table mu[mpm body * n_fem + fem body].
+ContactParams contact_from(const ParameterList& p) {
+  const auto& c = p.sublist("Contact");
+  const auto& mpm = p.sublist("MPM Bodies");
+  const auto& fem = p.sublist("FEM Bodies");
+  ContactParams cp;
+  cp.dhat = c.get<double>("dhat");
+  cp.kappa = c.get<double>("kappa");
+  cp.eps_v = c.get<double>("eps_v");
+  cp.friction_max_iterations = c.get<int>("friction iterations");
+  const std::size_t nm = mpm.numParams(), nf = fem.numParams();
+  cp.mu.assign(nm * nf, c.get<double>("friction"));
+  const auto& pairs = c.sublist("Friction Pairs");
+  for (auto it = pairs.begin(); it != pairs.end(); ++it) {
+    const std::string key = "Contact/Friction Pairs/" + pairs.name(it);
+    const std::string name = pairs.name(it);
+    const auto colon = name.find(':');
+    const int a = colon == std::string::npos ? -1 : index_of(mpm, trim(name.substr(0, colon)));
+    const int b = colon == std::string::npos ? -1 : index_of(fem, trim(name.substr(colon + 1)));
+    if (a < 0 || b < 0) bad(key, "'" + name + "'", "a key '<MPM body> : <FEM body>' naming bodies of the scene");
+    const auto& e = pairs.entry(it);
+    double mu = -1;
+    if (e.isType<double>()) mu = Teuchos::getValue<double>(e);
+    else if (e.isType<int>()) mu = Teuchos::getValue<int>(e);
+    else bad(key, Teuchos::toString(e.getAny()), "a number mu >= 0");
+    if (!(mu >= 0)) bad(key, num(mu), "mu >= 0");
+    cp.mu[a * nf + b] = mu;
+  }
+  const std::string fb = c.get<std::string>("force body");
+  cp.force_body = fb.empty() ? -1 : index_of(fem, fb);
+  return cp;
 }
 
 std::array<double, 3> vec3(const Array<double>& a, int dim, const std::string& key) {
@@ -164,6 +218,7 @@ void build_mpm(const Scene& scene, const std::vector<std::string>& mat_names, Si
   MpmSetup<dim> mpm;
   const std::string tr = m.get<std::string>("transfer");
   mpm.scheme = tr == "PIC" ? TransferScheme::PIC : tr == "FLIP" ? TransferScheme::FLIP : TransferScheme::APIC;
+  mpm.extend_domain = m.get<std::string>("when particles leave") == "extend";
   try {
     mpm.grid = grid_covering<dim>(vecd<dim>(m.get<Array<double>>("domain min"), "MPM/domain min"),
                                   vecd<dim>(m.get<Array<double>>("domain max"), "MPM/domain max"), dx);
@@ -215,29 +270,39 @@ void build_mpm(const Scene& scene, const std::vector<std::string>& mat_names, Si
     const auto& l = lss.sublist(lss.name(it));
     LevelSet ls;
     ls.name = lss.name(it);
-    ls.kind = l.get<std::string>("type") == "box" ? LevelSetKind::Box : LevelSetKind::HalfPlane;
+    const std::string type = l.get<std::string>("type");
+    ls.kind = type == "box" ? LevelSetKind::Box : type == "sine" ? LevelSetKind::Sine : LevelSetKind::HalfPlane;
     ls.slip = l.get<bool>("slip");
     ls.velocity = vec3(l.get<Array<double>>("velocity"), dim, key + "/velocity");
     if (ls.kind == LevelSetKind::HalfPlane) {
       ls.point = vec3(l.get<Array<double>>("point"), dim, key + "/point");  // default: origin
       const Vec<dim> n = vecd<dim>(l.get<Array<double>>("normal"), key + "/normal");
-      if (!(n.norm() > 0)) bad(key + "/normal", Teuchos::toString(l.get<Array<double>>("normal")), "a non-zero normal");
+      if (!(n.norm() > 0) || !std::isfinite(n.norm()))
+        bad(key + "/normal", Teuchos::toString(l.get<Array<double>>("normal")), "a finite non-zero normal");
       const Vec<dim> u = n.normalized();
       for (int d = 0; d < dim; ++d) ls.normal[d] = u(d);
       int axis = 0;
       u.cwiseAbs().maxCoeff(&axis);
       ls.normal_axis = axis;
-      if (ls.slip && std::abs(std::abs(u(axis)) - 1.0) > 1e-12)
-        bad(key + "/normal", Teuchos::toString(l.get<Array<double>>("normal")),
-            "an axis-aligned normal for a slip boundary (general slip normals are not supported yet)");
+    } else if (ls.kind == LevelSetKind::Sine) {
+      ls.height = l.get<double>("height");
+      ls.amplitude = l.get<double>("amplitude");
+      ls.wavelength = l.get<double>("wavelength");
+      ls.solid_above = l.get<std::string>("solid") == "above";
+      if (!std::isfinite(ls.height)) bad(key + "/height", num(ls.height), "a finite height (m)");
+      if (!std::isfinite(ls.amplitude)) bad(key + "/amplitude", num(ls.amplitude), "a finite amplitude (m)");
+      if (!(ls.wavelength > 0) || !std::isfinite(ls.wavelength))
+        bad(key + "/wavelength", num(ls.wavelength), "a finite wavelength > 0 (m) for type sine");
     } else {
       const Vec<dim> lo = vecd<dim>(l.get<Array<double>>("box min"), key + "/box min");
       const Vec<dim> hi = vecd<dim>(l.get<Array<double>>("box max"), key + "/box max");
       for (int d = 0; d < dim; ++d) {
         ls.box_min[d] = lo(d);
         ls.box_max[d] = hi(d);
+        if (!(hi(d) > lo(d)))
+          bad(key + "/box max", Teuchos::toString(l.get<Array<double>>("box max")),
+              "every component > box min's (" + Teuchos::toString(l.get<Array<double>>("box min")) + ")");
       }
-      if (ls.slip) bad(key + "/slip", "true", "false for a box (slip needs a single normal)");
     }
     setup.level_sets.push_back(ls);
   }
@@ -342,6 +407,7 @@ SimulationSetup<dim> build_setup(const Scene& scene) {
     setup.bodies.push_back(std::move(in));
   }
   build_mpm<dim>(scene, mat_names, setup);
+  if (setup.mpm && !setup.bodies.empty() && p.sublist("Contact").get<bool>("enabled")) setup.contact = contact_from(p);
   const auto& time = p.sublist("Time");
   setup.dt = time.get<double>("dt");
   if (time.get<std::string>("integrator") == "newmark") {
@@ -391,6 +457,11 @@ std::string scene_summary(const Scene& scene) {
       << p.sublist("MPM").get<int>("particles per cell") << " particles per cell, "
       << p.sublist("MPM").get<std::string>("transfer") << ", " << p.sublist("Level Sets").numParams()
       << " level set(s)\n";
+  const auto& c = p.sublist("Contact");
+  if (mpm.numParams() > 0 && bodies.numParams() > 0 && c.get<bool>("enabled"))
+    s << "  contact: barrier dhat " << c.get<double>("dhat") << " m, kappa " << c.get<double>("kappa")
+      << " Pa, friction " << c.get<double>("friction") << " (" << c.sublist("Friction Pairs").numParams()
+      << " pair override(s)), eps_v " << c.get<double>("eps_v") << " m/s\n";
   return s.str();
 }
 

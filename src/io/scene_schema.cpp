@@ -85,13 +85,21 @@ ParameterList mpm_body_schema() {
 
 ParameterList level_set_schema() {
   ParameterList l("level set");
-  choice(l, "type", "half-plane", "solid where (x - point) . normal < 0, or inside a box",
-         tuple<std::string>("half-plane", "box"));
-  l.set("slip", false, "true: only the normal velocity is constrained (axis-aligned normals)");
+  choice(l, "type", "half-plane",
+         "solid where (x - point) . normal < 0, inside a box, or below/above the sine contour "
+         "y = height + amplitude cos(2 pi x / wavelength) (extruded along z in 3D)",
+         tuple<std::string>("half-plane", "box", "sine"));
+  l.set("slip", false,
+        "true: only the velocity along the level set's normal at each node inside is constrained "
+        "(n . v = n . v_boundary), the tangential motion is free; false: no-slip");
   l.set("point", Array<double>(), "half-plane: a point on the plane (m)");
   l.set("normal", Array<double>(), "half-plane: normal pointing into the free side");
   l.set("box min", Array<double>(), "box: lower corner (m)");
   l.set("box max", Array<double>(), "box: upper corner (m)");
+  l.set("height", 0.0, "sine: y of the contour's mean line (m)");
+  l.set("amplitude", 0.0, "sine: amplitude A of the contour (m)");
+  l.set("wavelength", 0.0, "sine: wavelength (m), > 0 for type sine");
+  choice(l, "solid", "below", "sine: the solid side of the contour", tuple<std::string>("below", "above"));
   l.set("velocity", Array<double>(), "m/s, constant motion of the boundary (default 0)");
   return l;
 }
@@ -147,8 +155,25 @@ Teuchos::RCP<const ParameterList> scene_schema() {
   mpm.set("domain max", Array<double>(), "upper corner of the grid domain (m)");
   mpm.set("particles per cell", 4, "1, 4, 9, 16 (2D); 1, 8, 27 (3D)");
   choice(mpm, "transfer", "APIC", "paper Tables 1-3", tuple<std::string>("APIC", "PIC", "FLIP"));
+  choice(mpm, "when particles leave", "error",
+         "a particle whose B-spline stencil leaves the grid domain: stop with an error naming it and "
+         "the step, or extend the grid by whole cells before the step",
+         tuple<std::string>("error", "extend"));
   pl->sublist("MPM Bodies", false, "named MPM bodies (particles)").disableRecursiveValidation();
   pl->sublist("Level Sets", false, "grid boundaries of the MPM bodies").disableRecursiveValidation();
+  auto& contact = pl->sublist("Contact", false,
+                              "barrier contact between MPM particles and FEM boundaries (paper section 4); on when the "
+                              "scene has both MPM and FEM bodies");
+  contact.set("enabled", true, "false: MPM and FEM bodies pass through each other");
+  contact.set("dhat", 1e-3, "contact activation distance (m), > 0");
+  contact.set("kappa", 1e5, "barrier stiffness (Pa), > 0");
+  contact.set("eps_v", 1e-3, "static-friction velocity bound (m/s), > 0");
+  contact.set("friction", 0.0, "Coulomb coefficient mu of every MPM/FEM body pair, >= 0");
+  contact.sublist("Friction Pairs", false,
+                  "per-pair mu overriding 'friction': keys '<MPM body> : <FEM body>' (spaces optional)")
+      .disableRecursiveValidation();
+  contact.set("friction iterations", 20, "cap of the outer friction loop per step (paper Algorithm 1), >= 1");
+  contact.set("force body", std::string(""), "FEM body whose contact force goes to diagnostics.csv (default: all)");
   return pl;
 }
 

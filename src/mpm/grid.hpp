@@ -129,4 +129,41 @@ GridSpec<dim> grid_covering(const Vec<dim>& lo, const Vec<dim>& hi, double dx) {
   return g;
 }
 
+// `g` grown by whole cells (same dx; nodes stay on the same lattice, so the
+// origin moves by whole cells) until every point of [lo, hi] is usable
+// (contains() is true), each side that grows getting `margin` further cells
+// (the option 'MPM/when particles leave: extend'). Throws std::invalid_argument
+// for non-finite bounds or when the grid would have more nodes than a local
+// ordinal can count.
+template <int dim>
+GridSpec<dim> grid_extended(const GridSpec<dim>& g, const Vec<dim>& lo, const Vec<dim>& hi, int margin) {
+  GridSpec<dim> e = g;
+  double nodes = 1.0;
+  for (int d = 0; d < dim; ++d) {
+    if (!std::isfinite(lo[d]) || !std::isfinite(hi[d]))
+      throw std::invalid_argument("grid_extended: non-finite bound on axis " + std::to_string(d));
+    // Cell offsets relative to g's origin: the new grid spans cells [first, last).
+    double first = 0.0, last = g.n_cells[d];
+    auto usable = [&](double x, double f, double l) {
+      const double r = (x - (g.origin[d] + f * g.dx)) / g.dx - 0.5;
+      return r >= 0.0 && r < (l - f) - 1.0;
+    };
+    const double need_lo = std::floor((lo[d] - g.origin[d]) / g.dx - 0.5);
+    const double need_hi = std::floor((hi[d] - g.origin[d]) / g.dx + 0.5) + 1.0;
+    if (need_lo < first) first = need_lo - margin;
+    if (need_hi > last) last = need_hi + margin;
+    while (!usable(lo[d], first, last)) first -= 1.0;  // ulp-level rounding of (x - origin) / dx
+    while (!usable(hi[d], first, last)) last += 1.0;
+    if (!(last - first < 0.5 * std::numeric_limits<LO>::max()))
+      throw std::invalid_argument("grid_extended: axis " + std::to_string(d) + " would have " +
+                                  std::to_string(last - first) + " cells");
+    e.origin[d] = g.origin[d] + first * g.dx;
+    e.n_cells[d] = static_cast<int>(last - first);
+    nodes *= e.n_cells[d] + 1.0;
+  }
+  if (!(nodes < static_cast<double>(std::numeric_limits<LO>::max())))
+    throw std::invalid_argument("grid_extended: the grid would have " + std::to_string(nodes) + " nodes");
+  return e;
+}
+
 }  // namespace bfemp

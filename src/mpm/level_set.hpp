@@ -1,9 +1,12 @@
 #pragma once
 // Level-set boundaries on the MPM grid (paper §6.2 baseline, §6.6 feet): a
-// half-plane (solid where (x - point) . normal < 0) or a box (solid inside),
-// optionally moving with a constant velocity. Grid nodes inside are
-// constrained: no-slip fixes every component to the boundary's motion; slip
-// fixes only the normal component (axis-aligned normals in this version).
+// half-plane (solid where (x - point) . normal < 0), a box (solid inside), or
+// an analytic sine contour y = y0 + A cos(2 pi x / wavelength) (extruded along
+// z in 3D; solid below or above it), each optionally moving with a constant
+// velocity. Grid nodes inside are constrained: no-slip fixes every component
+// to the boundary's motion (apply_level_sets below); slip fixes only the
+// velocity along the level set's normal at the node, n . v = n . v_boundary,
+// as a constraint of the Newton system (solver/slip_constraints.hpp).
 #include <Kokkos_Core.hpp>
 #include <array>
 #include <cmath>
@@ -14,7 +17,7 @@
 
 namespace bfemp {
 
-enum class LevelSetKind { HalfPlane, Box };
+enum class LevelSetKind { HalfPlane, Box, Sine };
 
 struct LevelSet {
   std::string name;
@@ -24,9 +27,15 @@ struct LevelSet {
   std::array<double, 3> normal{0, 1, 0};    // half-plane: unit normal into the free side
   std::array<double, 3> box_min{0, 0, 0}, box_max{0, 0, 0};
   std::array<double, 3> velocity{0, 0, 0};  // m/s, constant
-  int normal_axis = 1;                      // slip: the axis of the normal
+  int normal_axis = 1;                      // half-plane: the axis closest to the normal
+  // sine: contour y = height + amplitude cos(2 pi x / wavelength) at t = 0;
+  // solid below it (solid_above false) or above it.
+  double height = 0, amplitude = 0, wavelength = 1;
+  bool solid_above = false;
 
-  // Signed distance-like value at time t: < 0 inside the solid.
+  // Signed value at time t, < 0 inside the solid (a signed distance for the
+  // half-plane and the box; for the sine its first-order estimate
+  // (y - y_c(x)) / |grad (y - y_c(x))|).
   template <int dim>
   KOKKOS_INLINE_FUNCTION double phi(const Vec<dim>& x, double t) const {
     if (kind == LevelSetKind::HalfPlane) {
@@ -34,12 +43,53 @@ struct LevelSet {
       for (int d = 0; d < dim; ++d) s += (x(d) - point[d] - velocity[d] * t) * normal[d];
       return s;
     }
+    if (kind == LevelSetKind::Sine) {
+      double dfdx = 0;
+      const double f = sine_function(x(0), x(1), t, dfdx);
+      return (solid_above ? -f : f) / std::sqrt(1.0 + dfdx * dfdx);
+    }
     double s = -1e300;  // box: negative inside (max over faces of the outside distance)
     for (int d = 0; d < dim; ++d) {
       const double lo = box_min[d] + velocity[d] * t, hi = box_max[d] + velocity[d] * t;
       s = std::fmax(s, std::fmax(lo - x(d), x(d) - hi));
     }
     return s;
+  }
+
+  // Unit normal at x pointing out of the solid (into the free side):
+  // half-plane: its normal; sine: the normalised gradient of the contour
+  // function s (y - y_c(x)); box: the outward normal of the nearest face.
+  template <int dim>
+  KOKKOS_INLINE_FUNCTION Vec<dim> unit_normal(const Vec<dim>& x, double t) const {
+    Vec<dim> n = Vec<dim>::Zero();
+    if (kind == LevelSetKind::HalfPlane) {
+      for (int d = 0; d < dim; ++d) n(d) = normal[d];
+    } else if (kind == LevelSetKind::Sine) {
+      double dfdx = 0;
+      sine_function(x(0), x(1), t, dfdx);
+      const double s = (solid_above ? -1.0 : 1.0) / std::sqrt(1.0 + dfdx * dfdx);
+      n(0) = s * dfdx;
+      n(1) = s;
+    } else {
+      double best = -1e300;
+      int axis = 0;
+      double sign = 1;
+      for (int d = 0; d < dim; ++d) {
+        const double lo = box_min[d] + velocity[d] * t, hi = box_max[d] + velocity[d] * t;
+        if (lo - x(d) > best) { best = lo - x(d); axis = d; sign = -1; }
+        if (x(d) - hi > best) { best = x(d) - hi; axis = d; sign = 1; }
+      }
+      n(axis) = sign;
+    }
+    return n;
+  }
+
+  // Sine: f = y - y_c(x, t) and df/dx, with the contour moved by velocity t.
+  KOKKOS_INLINE_FUNCTION double sine_function(double x, double y, double t, double& dfdx) const {
+    const double k = 2.0 * M_PI / wavelength;
+    const double xs = x - velocity[0] * t;
+    dfdx = amplitude * k * std::sin(k * xs);
+    return y - (height + velocity[1] * t + amplitude * std::cos(k * xs));
   }
 };
 
@@ -50,8 +100,10 @@ struct LevelSetList {
   int count = 0;
 };
 
-// Constrains the grid DOFs [first_dof, n) whose node is inside a level set at
-// time t: prescribed = 1, target = x + dt * v_boundary, v = v_boundary.
+// No-slip level sets: constrains every DOF of the grid nodes [first_dof, n)
+// that lie inside a no-slip level set at time t: prescribed = 1, target =
+// x + dt * v_boundary, v = v_boundary. Slip level sets are left to
+// SlipConstraints::build (solver/slip_constraints.hpp).
 template <int dim, class XV, class PV>
 void apply_level_sets(const LevelSetList& ls, double t, double dt, std::size_t first_dof, std::size_t n,
                       const XV& x, const XV& v, const XV& target, const PV& prescribed) {
@@ -62,9 +114,8 @@ void apply_level_sets(const LevelSetList& ls, double t, double dt, std::size_t f
         for (int c = 0; c < dim; ++c) xi(c) = x(node * dim + c);
         for (int k = 0; k < ls.count; ++k) {
           const LevelSet& s = ls.sets[k];
-          if (s.phi<dim>(xi, t) > 0) continue;
+          if (s.slip || s.phi<dim>(xi, t) > 0) continue;
           for (int c = 0; c < dim; ++c) {
-            if (s.slip && c != s.normal_axis) continue;
             const std::size_t i = node * dim + c;
             prescribed(i) = 1;
             target(i) = x(i) + dt * s.velocity[c];

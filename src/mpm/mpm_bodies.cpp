@@ -1,6 +1,7 @@
 #include "mpm/mpm_bodies.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <stdexcept>
 #include <unordered_set>
 
@@ -39,10 +40,37 @@ LO MpmBodies<dim>::begin_step(LO first, long step) {
   if (out >= 0) {
     auto x = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), p.x);
     std::string pos;
-    for (int d = 0; d < dim; ++d) pos += (d ? ", " : "") + std::to_string(x(out, d));
-    throw std::runtime_error("step " + std::to_string(step) + ": MPM particle " + std::to_string(out) +
-                             " at (" + pos + ") left the grid domain (its B-spline stencil needs half a cell "
-                             "inside the grid); enlarge the scene's MPM grid domain");
+    bool finite = true;
+    for (int d = 0; d < dim; ++d) {
+      pos += (d ? ", " : "") + std::to_string(x(out, d));
+      finite = finite && std::isfinite(x(out, d));
+    }
+    const std::string who = "step " + std::to_string(step) + ": MPM particle " + std::to_string(out) + " at (" + pos + ")";
+    if (!setup_.extend_domain)
+      throw std::runtime_error(who + " left the grid domain (its B-spline stencil needs half a cell "
+                               "inside the grid); enlarge the scene's MPM grid domain or set "
+                               "'MPM/when particles leave: extend'");
+    if (!finite) throw std::runtime_error(who + " has a non-finite position; the grid cannot be extended to it");
+    Vec<dim> lo, hi;  // bounding box of the particles
+    for (int d = 0; d < dim; ++d) {
+      lo(d) = hi(d) = x(0, d);
+      for (std::size_t q = 0; q < x.extent(0); ++q) {
+        if (!std::isfinite(x(q, d)))
+          throw std::runtime_error("step " + std::to_string(step) + ": MPM particle " + std::to_string(q) +
+                                   " has a non-finite position; the grid cannot be extended to it");
+        lo(d) = std::min(lo(d), x(q, d));
+        hi(d) = std::max(hi(d), x(q, d));
+      }
+    }
+    int margin = 2;
+    for (int d = 0; d < dim; ++d) margin = std::max(margin, grid.n_cells[d] / 4);
+    try {
+      setup_.grid = grid_extended(grid, lo, hi, margin);
+    } catch (const std::invalid_argument& e) {
+      throw std::runtime_error(who + " left the grid domain and extending it failed: " + e.what());
+    }
+    ++extensions_;
+    system_node_ = Kokkos::View<LO*, MemSpace>("mpm_system_node", setup_.grid.num_nodes());
   }
   first_ = first;
   active_ = activate_grid(grid, p, first, system_node_, grid_node_);

@@ -1,6 +1,7 @@
 #include "sim/simulation.hpp"
 
 #include <Kokkos_Timer.hpp>
+#include <iostream>
 #include <sstream>
 
 #include "solver/solver_error.hpp"
@@ -13,14 +14,14 @@ using View1 = Kokkos::View<double*, MemSpace>;
 // shrinks, so steps do not reallocate.
 template <int dim>
 struct Simulation<dim>::System {
-  View1 x, v, v_old, a, x_hat, target, mass, work;
+  View1 x, v, v_old, a, x_hat, target, mass, work, x_ref;
   Kokkos::View<int*, MemSpace> prescribed;
   std::size_t n = 0;
   void resize(std::size_t nd) {
     n = nd;
     if (x.extent(0) >= nd) return;
     const std::size_t cap = nd + nd / 4;
-    for (View1* w : {&x, &v, &v_old, &a, &x_hat, &target, &mass, &work}) *w = View1(w->label(), cap);
+    for (View1* w : {&x, &v, &v_old, &a, &x_hat, &target, &mass, &work, &x_ref}) *w = View1(w->label(), cap);
     prescribed = Kokkos::View<int*, MemSpace>("sys_prescribed", cap);
   }
   template <class V>
@@ -80,6 +81,10 @@ Simulation<dim>::Simulation(SimulationSetup<dim> setup, const Teuchos::RCP<const
     }
   Kokkos::deep_copy(v_, v);
   Kokkos::deep_copy(prescribed_, pres);
+  if (setup_.contact && mpm_ && mesh_.num_nodes() > 0) {
+    contact_ = std::make_unique<Contact<dim>>(mesh_, *setup_.contact);
+    contact_->check_initial(mpm_->particles(), x_);
+  }
   reset_acceleration();
 }
 
@@ -171,7 +176,13 @@ StepReport Simulation<dim>::step() {
     Kokkos::deep_copy(Kokkos::subview(pres, grid_part), 0);
     mpm_->fill_system(x, v, mass);
     apply_level_sets<dim>(level_sets_, time_, dt, nfd, nd, x, v, target, pres);
+    newton_->slip_constraints().build(level_sets_, time_, dt, nfd, nd, x, v, pres);  // slip: n . v = n . v_b
     terms.push_back(&mpm_->term());
+    if (contact_) {
+      contact_->begin_step(*mpm_, x);
+      terms.push_back(contact_->barrier());
+      if (contact_->has_friction()) terms.push_back(contact_->friction());
+    }
     newton_->set_system(nF + nA, terms, true);
     // Grid a^n = g - M^-1 grad Psi(x^n) (the Newmark predictor needs it).
     auto work = System::head(S.work, nd);
@@ -191,13 +202,28 @@ StepReport Simulation<dim>::step() {
 
   IncrementalPotential ip{xhat, mass, pres, target, h, dt};
   NewtonStats ns;
+  int friction_iters = 0;
   try {
-    ns = newton_->minimize(ip, x);
+    if (contact_ && contact_->has_friction()) {
+      // dt v^{n+1} = s (x - x_ref) for the integrator's velocity update.
+      const double gm = ti.gamma, s = gm * dt * dt / h;
+      auto xref = System::head(S.x_ref, nd);
+      Kokkos::parallel_for(
+          "friction_x_ref", Kokkos::RangePolicy<ExecSpace>(0, nd), KOKKOS_LAMBDA(const std::size_t i) {
+            xref(i) = xhat(i) - h * g[i % dim] - (dt * v(i) + dt * dt * (1.0 - gm) * a(i)) / s;
+          });
+      ns = minimize_with_friction(ip, x, xref, s, friction_iters);
+    } else {
+      ns = newton_->minimize(ip, x);
+      friction_iters = 1;
+    }
   } catch (const SolverError& e) {
     std::ostringstream msg;
     msg << "step " << step_ + 1 << " (t = " << t1 << " s): " << e.what();
     throw SolverError(msg.str());
   }
+  typename Contact<dim>::Report contact_report;
+  if (contact_) contact_report = contact_->report(x, nF);
 
   const double gamma = ti.gamma;
   Kokkos::parallel_for(
@@ -207,6 +233,7 @@ StepReport Simulation<dim>::step() {
         v(i) += dt * ((1.0 - gamma) * a(i) + gamma * a1);
         a(i) = a1;
       });
+  if (mpm_) newton_->slip_constraints().project_velocities(v);
   Kokkos::deep_copy(x_, Kokkos::subview(x, fem));
   Kokkos::deep_copy(v_, Kokkos::subview(v, fem));
   Kokkos::deep_copy(a_, Kokkos::subview(a, fem));
@@ -217,8 +244,46 @@ StepReport Simulation<dim>::step() {
   StepReport r = diagnostics();
   r.newton = ns;
   r.active_grid_nodes = nA;
+  if (contact_) {
+    r.contact_pairs = contact_report.pairs;
+    r.min_distance = contact_report.min_distance;
+    r.barrier_energy = contact_report.barrier_energy;
+    r.ccd_alpha_min = contact_report.ccd_alpha_min;
+    r.contact_force = contact_report.force;
+    r.friction_iters = friction_iters;
+  }
   r.step_s = timer.seconds();
   return r;
+}
+
+// Algorithm 1 lines 5-10: lag friction at x^n, minimise, re-lag at the
+// result, repeat until the first Newton direction of a re-solve is below
+// eps_d (the friction update no longer moves the solution) or the cap.
+template <int dim>
+NewtonStats Simulation<dim>::minimize_with_friction(const IncrementalPotential& ip, View1 x, View1 x_ref, double s,
+                                                    int& iterations) {
+  NewtonStats total;
+  const int cap = contact_->friction_max_iterations();
+  LO lagged = contact_->update_friction(x, x_ref, s, ip.dt);  // line 5: lagged at x^n
+  for (iterations = 1;; ++iterations) {
+    const NewtonStats st = newton_->minimize(ip, x);
+    total.iterations += st.iterations;
+    total.linear_iterations += st.linear_iterations;
+    total.assembly_s += st.assembly_s;
+    total.solve_s += st.solve_s;
+    total.line_search_s += st.line_search_s;
+    total.min_step = std::min(total.min_step, st.min_step);
+    if (iterations > 1 && st.iterations == 1) break;  // converged at the lagged update
+    const LO relagged = contact_->update_friction(x, x_ref, s, ip.dt);
+    if (lagged == 0 && relagged == 0) break;  // no friction pairs before or after
+    lagged = relagged;
+    if (iterations == cap) {
+      std::cerr << "warning: step " << step_ + 1 << ": friction not converged in " << cap
+                << " outer iterations ('Contact/friction iterations')\n";
+      break;
+    }
+  }
+  return total;
 }
 
 template <int dim>

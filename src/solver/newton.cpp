@@ -28,6 +28,7 @@ struct NewtonSolver<dim>::Impl {
   View1 grad, rhs, dx_prescribed, dir, trial;
   Teuchos::RCP<Teuchos::ParameterList> fill_params;
   double graph_build_s = 0;
+  SlipConstraints<dim> slip;  // normal-velocity constraints (slip level sets)
 
   Impl(const Teuchos::RCP<const Comm>& c, const Teuchos::ParameterList& ls, NewtonParams np)
       : comm(c), params(np), solver(ls, c) {
@@ -87,6 +88,7 @@ struct NewtonSolver<dim>::Impl {
           }
           lcl.sumIntoValues(i, &i, 1, &diag, false, true);
         });
+    slip.transform_system(lcl, r);  // A <- P A P + Q, r <- P (r - A w) + w on slip nodes
     A->fillComplete(fill_params);
   }
 };
@@ -104,6 +106,11 @@ void NewtonSolver<dim>::set_system(LO n_nodes, std::vector<const EnergyTerm<dim>
                                    bool structure_changed) {
   impl_->terms = std::move(terms);
   if (structure_changed || n_nodes != impl_->n_nodes || impl_->A.is_null()) impl_->rebuild(n_nodes);
+}
+
+template <int dim>
+SlipConstraints<dim>& NewtonSolver<dim>::slip_constraints() {
+  return impl_->slip;
 }
 
 template <int dim>
@@ -170,6 +177,7 @@ NewtonStats NewtonSolver<dim>::minimize(const IncrementalPotential& ip, View1 x)
           acc = std::fmax(acc, std::fabs(dxp(i)));
         },
         Kokkos::Max<double>(pres_left));
+    pres_left = std::max(pres_left, m.slip.update_offsets(x));  // remaining slip offsets
 
     timer.reset();
     bool grow = false;
@@ -202,6 +210,13 @@ NewtonStats NewtonSolver<dim>::minimize(const IncrementalPotential& ip, View1 x)
           acc = std::fmax(acc, std::fabs(dir(i)));
         },
         Kokkos::Max<double>(p_inf));
+    if (m.slip.count() > 0) {  // exact normal part at slip nodes, as for prescribed DOFs
+      m.slip.fix_direction(dir);
+      Kokkos::parallel_reduce(
+          "newton_dir_norm_slip", Kokkos::RangePolicy<ExecSpace>(0, x.extent(0)),
+          KOKKOS_LAMBDA(const LO i, double& acc) { acc = std::fmax(acc, std::fabs(dir(i))); },
+          Kokkos::Max<double>(p_inf));
+    }
     if (!std::isfinite(p_inf))
       throw SolverError("Newton direction is not finite (linear solve produced NaN/Inf)");
 

@@ -14,6 +14,7 @@
 
 #include "solver/energy_term.hpp"
 #include "solver/linear_solver.hpp"
+#include "solver/slip_constraints.hpp"
 #include "solver/tpetra_types.hpp"
 
 namespace bfemp {
@@ -68,6 +69,10 @@ class NewtonSolver {
 
   // Called after every accepted Newton iterate (debug checks, tests).
   std::function<void(Kokkos::View<const double*, MemSpace>)> on_iterate;
+
+  // Slip boundaries: exact linear constraints on grid nodes, rebuilt by the
+  // caller each step (SlipConstraints::build); empty by default.
+  SlipConstraints<dim>& slip_constraints();
 
   const LinearSolver& linear_solver() const;
   Teuchos::RCP<const Map> dof_map() const;
