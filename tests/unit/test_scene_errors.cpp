@@ -181,3 +181,48 @@ bfemp:
   expect_message(error_of(with("domain max: [1.0, 1.0]", "domain max: [1.0]")), {"MPM/domain max", "2 components"});
   expect_message(error_of(with("shape: box", "shape: blob")), {"MPM Bodies/block/shape", "blob"});
 }
+
+TEST(SceneErrors, LevelSetsAndGridGrowth) {
+  const std::string mpm = R"(%YAML 1.1
+---
+bfemp:
+  dimension: 2
+  Materials:
+    soft: {E: 1.0e5, nu: 0.3, density: 1000.0}
+  MPM:
+    grid spacing: 0.05
+    domain min: [0.0, 0.0]
+    domain max: [1.0, 1.0]
+    when particles leave: extend
+  MPM Bodies:
+    block: {material: soft, shape: box, center: [0.5, 0.5], size: [0.2, 0.2]}
+  Level Sets:
+    waves: {type: sine, slip: true, height: 0.9, amplitude: 0.025, wavelength: 0.1, solid: above, velocity: [0.0, -1.0]}
+    incline: {type: half-plane, slip: true, point: [0.0, 0.2], normal: [-0.5, 1.0]}
+    walls: {type: box, slip: true, box min: [-1.0, -1.0], box max: [0.05, 2.0]}
+...
+)";
+  auto with = [&](const std::string& from, const std::string& to) {
+    std::string s = mpm;
+    EXPECT_NE(s.find(from), std::string::npos) << from;
+    s.replace(s.find(from), from.size(), to);
+    return s;
+  };
+  EXPECT_EQ(error_of(mpm), "");
+  EXPECT_EQ(error_of(with("when particles leave: extend", "when particles leave: error")), "");
+  expect_message(error_of(with("when particles leave: extend", "when particles leave: grow")),
+                 {"when particles leave", "grow", "error", "extend"});
+  expect_message(error_of(with("wavelength: 0.1", "wavelength: 0.0")),
+                 {"Level Sets/waves/wavelength", "0", "wavelength > 0"});
+  expect_message(error_of(with("wavelength: 0.1", "wavelength: -2.0")), {"Level Sets/waves/wavelength", "-2"});
+  expect_message(error_of(with("type: sine", "type: sinus")), {"type", "sinus", "sine"});
+  expect_message(error_of(with("solid: above", "solid: left")), {"solid", "left", "below"});
+  expect_message(error_of(with("normal: [-0.5, 1.0]", "normal: [0.0, 0.0]")),
+                 {"Level Sets/incline/normal", "non-zero normal"});
+  expect_message(error_of(with("normal: [-0.5, 1.0]", "normal: [-0.5, 1.0, 0.0]")),
+                 {"Level Sets/incline/normal", "2 components"});
+  expect_message(error_of(with("box max: [0.05, 2.0]", "box max: [0.05, -2.0]")),
+                 {"Level Sets/walls/box max", "> box min"});
+  expect_message(error_of(with("velocity: [0.0, -1.0]", "velocity: [-1.0]")),
+                 {"Level Sets/waves/velocity", "2 components"});
+}
