@@ -3,14 +3,17 @@
 # threads and merges both runs into one JSON with the machine's description.
 # Builds nothing: build first with  ninja -C build bench_newton
 #
-#   perf/run_benchmarks.sh [--build-dir DIR] [--out FILE] [--threads "1 2"]
-#                          [--wait-quiet SECONDS] [-- options passed to bench_newton]
+#   perf/run_benchmarks.sh [--bench bench_newton|bench_mpm_newton] [--build-dir DIR]
+#                          [--out FILE] [--threads "1 2"]
+#                          [--wait-quiet SECONDS] [-- options passed to the benchmark]
 #
-# Defaults: --build-dir build, --out build/perf/newton.json, --threads "1 2".
+# Defaults: --bench bench_newton, --build-dir build, --out build/perf/newton.json
+# (bench_mpm_newton: build/perf/mpm_newton.json), --threads "1 2".
 # --wait-quiet S: before each thread count, wait up to S seconds for the CPUs
 # to be >= 95% idle for 6 s (the machine is shared; see perf/README.md).
 # Compare the result with the stored baseline:
 #   python3 perf/compare.py build/perf/newton.json
+#   python3 perf/compare.py build/perf/mpm_newton.json --baseline perf/baselines/mpm_newton.json
 set -euo pipefail
 
 repo="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
@@ -19,32 +22,39 @@ out=""
 threads="1 2"
 wait_quiet=0
 extra=()
+bench=bench_newton
 while [[ $# -gt 0 ]]; do
   case "$1" in
+    --bench) bench="$2"; shift 2 ;;
     --build-dir) build_dir="$(cd "$2" && pwd)"; shift 2 ;;
     --out) out="$2"; shift 2 ;;
     --threads) threads="$2"; shift 2 ;;
     --wait-quiet) wait_quiet="$2"; shift 2 ;;
     --) shift; extra=("$@"); break ;;
-    -h|--help) sed -n '2,14p' "${BASH_SOURCE[0]}"; exit 0 ;;
+    -h|--help) sed -n '2,17p' "${BASH_SOURCE[0]}"; exit 0 ;;
     *) echo "run_benchmarks.sh: unknown argument '$1' (see --help)" >&2; exit 2 ;;
   esac
 done
-[[ -n "$out" ]] || out="$build_dir/perf/newton.json"
-bin="$build_dir/perf/bench_newton"
+case "$bench" in
+  bench_newton) bench_json=newton; bench_name=newton_iteration ;;
+  bench_mpm_newton) bench_json=mpm_newton; bench_name=mpm_newton_iteration ;;
+  *) echo "run_benchmarks.sh: --bench '$bench': expected bench_newton or bench_mpm_newton" >&2; exit 2 ;;
+esac
+[[ -n "$out" ]] || out="$build_dir/perf/$bench_json.json"
+bin="$build_dir/perf/$bench"
 if [[ ! -x "$bin" ]]; then
-  echo "run_benchmarks.sh: $bin not found; build it first: ninja -C $build_dir bench_newton" >&2
+  echo "run_benchmarks.sh: $bin not found; build it first: ninja -C $build_dir $bench" >&2
   exit 2
 fi
 command -v python3 >/dev/null || { echo "run_benchmarks.sh: python3 is needed" >&2; exit 2; }
 
 # The script builds nothing, so say when the binary is older than the sources it
 # measures (the JSON records the git commit of the tree, not of the binary).
-stale="$(find "$repo/src" "$repo/kernels" "$repo/perf/bench_newton.cpp" -newer "$bin" \
+stale="$(find "$repo/src" "$repo/kernels" "$repo/perf/$bench.cpp" -newer "$bin" \
          \( -name '*.cpp' -o -name '*.hpp' \) -print -quit 2>/dev/null || true)"
 if [[ -n "$stale" ]]; then
   echo "run_benchmarks.sh: warning: $bin is older than ${stale#$repo/} (and maybe more);" \
-       "rebuild with: ninja -C $build_dir bench_newton" >&2
+       "rebuild with: ninja -C $build_dir $bench" >&2
 fi
 
 # Percentage of CPU time idle over the next 2 seconds (all CPUs, /proc/stat).
@@ -85,10 +95,10 @@ runs=()
 status=0
 for t in $threads; do
   check_quiet
-  echo "== bench_newton, OMP_NUM_THREADS=$t (load average: $(cut -d' ' -f1-3 /proc/loadavg))"
+  echo "== $bench, OMP_NUM_THREADS=$t (load average: $(cut -d' ' -f1-3 /proc/loadavg))"
   start=$(date +%s.%N)
   if ! OMP_NUM_THREADS=$t "$bin" --out "$tmp/threads$t.json" "${extra[@]}"; then
-    echo "run_benchmarks.sh: bench_newton failed at $t thread(s) (see above)" >&2
+    echo "run_benchmarks.sh: $bench failed at $t thread(s) (see above)" >&2
     status=1
   fi
   end=$(date +%s.%N)
@@ -98,7 +108,7 @@ done
 [[ ${#runs[@]} -gt 0 ]] || { echo "run_benchmarks.sh: no run produced output" >&2; exit 1; }
 
 mkdir -p "$(dirname "$out")"
-BENCH_BIN="$bin" BENCH_STALE="$stale" python3 - "$out" "$repo" "${runs[@]}" <<'PY'
+BENCH_NAME="$bench_name" BENCH_BIN="$bin" BENCH_STALE="$stale" python3 - "$out" "$repo" "${runs[@]}" <<'PY'
 import datetime, json, os, platform, subprocess, sys
 
 out, repo, runs = sys.argv[1], sys.argv[2], sys.argv[3:]
@@ -131,7 +141,7 @@ with open("/proc/loadavg") as f:
 dirty = sh("git", "--no-optional-locks", "status", "--porcelain", "--untracked-files=no")
 
 merged = {
-    "benchmark": "newton_iteration",
+    "benchmark": os.environ.get("BENCH_NAME", "newton_iteration"),
     "date": datetime.datetime.now().astimezone().isoformat(timespec="seconds"),
     "machine": {
         "hostname": platform.node(),
