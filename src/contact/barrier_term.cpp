@@ -1,5 +1,6 @@
 #include "contact/barrier_term.hpp"
 
+#include <Kokkos_Timer.hpp>
 #include <algorithm>
 #include <limits>
 #include <type_traits>
@@ -12,7 +13,32 @@ namespace bfemp {
 
 namespace {
 
+// Squared distance of pair (particle q, primitive j) at x.
+template <int dim, class Prims>
+KOKKOS_INLINE_FUNCTION double pair_distance2(const Prims& prims, const ConstDofView& x, const ConstDofView& xq,
+                                             LO q, LO j) {
+  double d2 = 0;
+  dispatch_nv<dim>(prims.count(j), [&](auto NV) {
+    constexpr int nv = decltype(NV)::value;
+    Vec<dim> v[nv];
+    for (int i = 0; i < nv; ++i) v[i] = load_vec<dim>(x, prims.nodes(j, i));
+    d2 = stencil_distance2_value<dim, nv>(load_vec<dim>(xq, q), v);
+  });
+  return d2;
+}
+
 constexpr double kCcdStepMax = 1.0 / 0.9;  // the solver takes 0.9 of the bound, capped at 1
+
+// Adds the seconds of its scope (after a fence) to a counter.
+struct ScopeTimer {
+  double& acc;
+  Kokkos::Timer t;
+  explicit ScopeTimer(double& a) : acc(a) {}
+  ~ScopeTimer() {
+    Kokkos::fence();
+    acc += t.seconds();
+  }
+};
 
 }  // namespace
 
@@ -40,6 +66,7 @@ void BarrierTerm<dim>::begin_step(const ParticleStencils<dim>& ps, ConstDofView 
 
 template <int dim>
 void BarrierTerm<dim>::find_pairs(ConstDofView x, ConstDofView p) const {
+  ScopeTimer timer(timings_.broad_phase_s);
   const bool moving = p.extent(0) > 0;
   interpolate_particles(ps_, x, xq_);
   if (moving) interpolate_particles(ps_, p, dq_);
@@ -52,6 +79,7 @@ void BarrierTerm<dim>::find_pairs(ConstDofView x, ConstDofView p) const {
 template <int dim>
 bool BarrierTerm<dim>::update(ConstDofView x) const {
   find_pairs(x, ConstDofView());
+  ScopeTimer timer(timings_.broad_phase_s);
   const auto keys = graph_keys_dev_;
   const auto pairs = pairs_;
   const long long np = prims_.size();
@@ -102,6 +130,7 @@ void BarrierTerm<dim>::add_couplings(std::vector<long long>& keys, LO n_nodes) c
 template <int dim>
 double BarrierTerm<dim>::energy(ConstDofView x) const {
   if (n_pairs_ == 0) return 0.0;
+  ScopeTimer timer(timings_.evaluation_s);
   interpolate_particles(ps_, x, xq_);
   const auto pairs = pairs_;
   const auto prims = prims_;
@@ -113,13 +142,8 @@ double BarrierTerm<dim>::energy(ConstDofView x) const {
       "barrier_energy", Kokkos::RangePolicy<ExecSpace>(0, n_pairs_),
       KOKKOS_LAMBDA(const LO k, double& acc) {
         const LO q = pairs(k, 0), j = pairs(k, 1);
-        dispatch_nv<dim>(prims.count(j), [&](auto NV) {
-          constexpr int nv = decltype(NV)::value;
-          Vec<dim> v[nv];
-          for (int i = 0; i < nv; ++i) v[i] = load_vec<dim>(x, prims.nodes(j, i));
-          const double d2 = stencil_distance2_value<dim, nv>(load_vec<dim>(xq, q), v);
-          if (d2 < dhat * dhat) acc += ps.omega(q) * prims.coef(j) * barrier(std::sqrt(d2), dhat, kappa);
-        });
+        const double d2 = pair_distance2<dim>(prims, x, xq, q, j);
+        if (d2 < dhat * dhat) acc += ps.omega(q) * prims.coef(j) * barrier(std::sqrt(d2), dhat, kappa);
       },
       e);
   return e;
@@ -128,6 +152,7 @@ double BarrierTerm<dim>::energy(ConstDofView x) const {
 template <int dim>
 template <class Body>
 void BarrierTerm<dim>::for_each_pair(ConstDofView x, const Body& body) const {
+  ScopeTimer timer(timings_.evaluation_s);
   interpolate_particles(ps_, x, xq_);
   const auto pairs = pairs_;
   const auto prims = prims_;
@@ -194,6 +219,7 @@ void BarrierTerm<dim>::particle_forces(ConstDofView x, DofView f) const {
 template <int dim>
 double BarrierTerm<dim>::max_step(ConstDofView x, ConstDofView p) const {
   if (n_pairs_ == 0) return std::numeric_limits<double>::infinity();
+  ScopeTimer timer(timings_.ccd_s);
   interpolate_particles(ps_, x, xq_);
   interpolate_particles(ps_, p, dq_);
   const auto pairs = pairs_;
@@ -223,6 +249,13 @@ double BarrierTerm<dim>::max_step(ConstDofView x, ConstDofView p) const {
 }
 
 template <int dim>
+typename BarrierTerm<dim>::Timings BarrierTerm<dim>::take_timings() const {
+  const Timings t = timings_;
+  timings_ = Timings{};
+  return t;
+}
+
+template <int dim>
 double BarrierTerm<dim>::take_ccd_min() const {
   const double t = ccd_min_;
   ccd_min_ = std::numeric_limits<double>::infinity();
@@ -241,13 +274,7 @@ typename BarrierTerm<dim>::ActivePairs BarrierTerm<dim>::active_pairs(ConstDofVi
   const double dhat = dhat_, kappa = kappa_;
   Kokkos::parallel_for(
       "contact_pair_distance", Kokkos::RangePolicy<ExecSpace>(0, n_pairs_), KOKKOS_LAMBDA(const LO k) {
-        const LO q = pairs(k, 0), j = pairs(k, 1);
-        dispatch_nv<dim>(prims.count(j), [&](auto NV) {
-          constexpr int nv = decltype(NV)::value;
-          Vec<dim> v[nv];
-          for (int i = 0; i < nv; ++i) v[i] = load_vec<dim>(x, prims.nodes(j, i));
-          dist(k) = std::sqrt(stencil_distance2_value<dim, nv>(load_vec<dim>(xq, q), v));
-        });
+        dist(k) = std::sqrt(pair_distance2<dim>(prims, x, xq, pairs(k, 0), pairs(k, 1)));
       });
   LO count = 0;
   Kokkos::parallel_reduce(

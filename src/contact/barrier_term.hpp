@@ -49,6 +49,10 @@ class BarrierTerm : public EnergyTerm<dim> {
 
   // Smallest CCD bound returned since the last call (inf if none); resets.
   double take_ccd_min() const;
+  // Seconds spent since the last call (resets): broad phase (pair finding and
+  // graph checks), pair evaluation (energy, gradient, Hessian), CCD.
+  struct Timings { double broad_phase_s = 0, evaluation_s = 0, ccd_s = 0; };
+  Timings take_timings() const;
   const BoundaryPrimitives<dim>& primitives() const { return prims_; }
   const ParticleStencils<dim>& particles() const { return ps_; }
   double dhat() const { return dhat_; }
@@ -72,6 +76,7 @@ class BarrierTerm : public EnergyTerm<dim> {
   mutable std::vector<long long> graph_keys_;  // q * n_prims + j, sorted
   mutable Kokkos::View<long long*, MemSpace> graph_keys_dev_;
   mutable double ccd_min_;
+  mutable Timings timings_;
 };
 
 }  // namespace bfemp

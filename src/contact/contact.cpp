@@ -114,6 +114,7 @@ typename Contact<dim>::Report Contact<dim>::report(ConstDofView x, LO n_fem_node
   r.min_distance = act.count > 0 ? dmin : std::numeric_limits<double>::infinity();
   r.barrier_energy = barrier_->energy(x);
   r.ccd_alpha_min = barrier_->take_ccd_min();
+  r.timings = barrier_->take_timings();  // of the solve (the report's own work is not counted)
   if (grad_.extent(0) != x.extent(0)) grad_ = Kokkos::View<double*, MemSpace>("contact_grad", x.extent(0));
   Kokkos::deep_copy(grad_, 0.0);
   barrier_->gradient(x, 1.0, grad_);

@@ -53,6 +53,7 @@ class Contact {
     double barrier_energy = 0;      // B(x), J (J/m in 2D)
     double ccd_alpha_min = 0;       // smallest CCD step bound this step (inf: none)
     std::array<double, 3> force{};  // contact force on the FEM body (or all)
+    typename BarrierTerm<dim>::Timings timings;  // this step's contact seconds
   };
   // At the step's solution x (system DOFs; the first n_fem_nodes are FEM).
   Report report(ConstDofView x, LO n_fem_nodes);

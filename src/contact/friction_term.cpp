@@ -92,35 +92,52 @@ void FrictionTerm<dim>::add_couplings(std::vector<long long>& keys, LO n_nodes) 
   for (LO k = 0; k < n_; ++k) add_pair_couplings(pn, vn, vc, pr(k, 0), pr(k, 1), n_nodes, true, keys);
 }
 
-// body(k, q, pd, u, Tk, ck): u the sliding displacement, per lagged pair.
+// The sliding displacement u_k = T_k^T sum_i c_ki s (x_i - x_ref,i) of each
+// lagged pair at x (particle positions interpolated from the grid).
 template <int dim>
-template <class Body>
-void FrictionTerm<dim>::for_each_pair(ConstDofView x, const Body& body) const {
+struct FrictionSliding {
+  ConstDofView x, xq, xr, xref;
+  BoundaryPrimitives<dim> prims;
+  Kokkos::View<LO* [2], MemSpace> pair;
+  Kokkos::View<double* [dim + 1], MemSpace> c;
+  Kokkos::View<double* [dim][dim - 1], MemSpace> T;
+  double s;
+  KOKKOS_INLINE_FUNCTION void operator()(LO k, Eigen::Matrix<double, dim, dim - 1>& Tk,
+                                         Eigen::Matrix<double, dim - 1, 1>& u) const {
+    const LO q = pair(k, 0), j = pair(k, 1);
+    for (int a = 0; a < dim; ++a)
+      for (int b = 0; b < dim - 1; ++b) Tk(a, b) = T(k, a, b);
+    Vec<dim> rel = c(k, 0) * s * (load_vec<dim>(xq, q) - load_vec<dim>(xr, q));
+    for (int i = 0; i < prims.count(j); ++i) {
+      const LO n = prims.nodes(j, i);
+      rel += c(k, 1 + i) * s * (load_vec<dim>(x, n) - load_vec<dim>(xref, n));
+    }
+    u = Tk.transpose() * rel;
+  }
+};
+
+template <int dim>
+FrictionSliding<dim> FrictionTerm<dim>::sliding(ConstDofView x) const {
   const auto& ps = barrier_.particles();
   interpolate_particles(ps, x, xq_);
   interpolate_particles(ps, x_ref_, xq_ref_);
-  const ConstDofView xq = xq_, xr = xq_ref_, xref = x_ref_;
-  const auto prims = barrier_.primitives();
-  const auto psc = ps;
-  const auto pair = pair_;
-  const auto c = c_;
-  const auto T = T_;
-  const double s = s_;
+  return {x, xq_, xq_ref_, x_ref_, barrier_.primitives(), pair_, c_, T_, s_};
+}
+
+// body(k, q, pd, u, Tk): u the sliding displacement, per lagged pair.
+template <int dim>
+template <class Body>
+void FrictionTerm<dim>::for_each_pair(ConstDofView x, const Body& body) const {
+  const FrictionSliding<dim> sl = sliding(x);
+  const auto psc = barrier_.particles();
   Kokkos::parallel_for(
       "friction_pairs", Kokkos::RangePolicy<ExecSpace>(0, n_), KOKKOS_LAMBDA(const LO k) {
-        const LO q = pair(k, 0), j = pair(k, 1);
-        const int nv = prims.count(j);
+        const LO q = sl.pair(k, 0), j = sl.pair(k, 1);
         Eigen::Matrix<double, dim, dim - 1> Tk;
-        for (int a = 0; a < dim; ++a)
-          for (int b = 0; b < dim - 1; ++b) Tk(a, b) = T(k, a, b);
-        Vec<dim> rel = c(k, 0) * s * (load_vec<dim>(xq, q) - load_vec<dim>(xr, q));
-        for (int i = 0; i < nv; ++i) {
-          const LO n = prims.nodes(j, i);
-          rel += c(k, 1 + i) * s * (load_vec<dim>(x, n) - load_vec<dim>(xref, n));
-        }
-        const Eigen::Matrix<double, dim - 1, 1> u = Tk.transpose() * rel;
+        Eigen::Matrix<double, dim - 1, 1> u;
+        sl(k, Tk, u);
         PairDofs<dim> pd;
-        fill_pair_dofs<dim>(psc, prims, q, j, nv, pd);
+        fill_pair_dofs<dim>(psc, sl.prims, q, j, sl.prims.count(j), pd);
         body(k, q, pd, u, Tk);
       });
 }
@@ -128,30 +145,17 @@ void FrictionTerm<dim>::for_each_pair(ConstDofView x, const Body& body) const {
 template <int dim>
 double FrictionTerm<dim>::energy(ConstDofView x) const {
   if (n_ == 0) return 0.0;
-  const auto& ps = barrier_.particles();
-  interpolate_particles(ps, x, xq_);
-  interpolate_particles(ps, x_ref_, xq_ref_);
-  const ConstDofView xq = xq_, xr = xq_ref_, xref = x_ref_;
-  const auto prims = barrier_.primitives();
-  const auto pair = pair_;
-  const auto c = c_;
-  const auto T = T_;
+  const FrictionSliding<dim> sl = sliding(x);
   const auto ml = ml_;
-  const double s = s_, eh = eh_;
+  const double eh = eh_;
   double e = 0;
   Kokkos::parallel_reduce(
       "friction_energy", Kokkos::RangePolicy<ExecSpace>(0, n_),
       KOKKOS_LAMBDA(const LO k, double& acc) {
-        const LO q = pair(k, 0), j = pair(k, 1);
-        Vec<dim> rel = c(k, 0) * s * (load_vec<dim>(xq, q) - load_vec<dim>(xr, q));
-        for (int i = 0; i < prims.count(j); ++i) {
-          const LO n = prims.nodes(j, i);
-          rel += c(k, 1 + i) * s * (load_vec<dim>(x, n) - load_vec<dim>(xref, n));
-        }
         Eigen::Matrix<double, dim, dim - 1> Tk;
-        for (int a = 0; a < dim; ++a)
-          for (int b = 0; b < dim - 1; ++b) Tk(a, b) = T(k, a, b);
-        acc += ml(k) * friction_f0((Tk.transpose() * rel).norm(), eh);
+        Eigen::Matrix<double, dim - 1, 1> u;
+        sl(k, Tk, u);
+        acc += ml(k) * friction_f0(u.norm(), eh);
       },
       e);
   return e;

@@ -16,6 +16,9 @@
 namespace bfemp {
 
 template <int dim>
+struct FrictionSliding;
+
+template <int dim>
 class FrictionTerm : public EnergyTerm<dim> {
  public:
   // mu(mpm body, fem body) as a row-major table [n_mpm x n_fem].
@@ -40,6 +43,7 @@ class FrictionTerm : public EnergyTerm<dim> {
  private:
   template <class Body>
   void for_each_pair(ConstDofView x, const Body& body) const;
+  FrictionSliding<dim> sliding(ConstDofView x) const;
 
   const BarrierTerm<dim>& barrier_;
   Kokkos::View<double*, MemSpace> mu_;  // [n_mpm * n_fem]

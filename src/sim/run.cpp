@@ -38,6 +38,10 @@ RunSummary run_dim(const Scene& scene, const std::string& dir, const Teuchos::RC
     s.assembly_s += r.newton.assembly_s;
     s.solve_s += r.newton.solve_s;
     s.line_search_s += r.newton.line_search_s;
+    s.contact = sim.contact() != nullptr;
+    s.contact_broad_phase_s += r.contact_broad_phase_s;
+    s.contact_eval_s += r.contact_eval_s;
+    s.contact_ccd_s += r.contact_ccd_s;
     if ((n + 1) % rc.output_every == 0 || n + 1 == n_steps) out.write_frame(sim);
     if (rc.progress_every > 0 && ((n + 1) % rc.progress_every == 0 || n + 1 == n_steps)) {
       const double el = wall.seconds();
@@ -66,7 +70,11 @@ RunSummary run_scene(const Scene& scene, const std::string& dir, const Teuchos::
       << "  linear iterations   " << s.linear_iterations << "\n"
       << "  assembly time       " << s.assembly_s << " s\n"
       << "  linear-solve time   " << s.solve_s << " s\n"
-      << "  line-search time    " << s.line_search_s << " s\n"
+      << "  line-search time    " << s.line_search_s << " s\n";
+  if (s.contact)
+    log << "  contact: broad phase " << s.contact_broad_phase_s << " s, pair evaluation " << s.contact_eval_s
+        << " s, CCD " << s.contact_ccd_s << " s (within the times above)\n";
+  log
       << "  wall time           " << s.wall_s << " s\n"
       << "  frames written      " << s.frames << " (" << dir << "/bfemp.xdmf)\n";
   return s;

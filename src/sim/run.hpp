@@ -13,6 +13,8 @@ struct RunSummary {
   long newton_iterations = 0;
   long linear_iterations = 0;
   double assembly_s = 0, solve_s = 0, line_search_s = 0, wall_s = 0;
+  bool contact = false;
+  double contact_broad_phase_s = 0, contact_eval_s = 0, contact_ccd_s = 0;  // parts of the above
   int frames = 0;
 };
 

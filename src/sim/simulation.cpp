@@ -251,6 +251,9 @@ StepReport Simulation<dim>::step() {
     r.ccd_alpha_min = contact_report.ccd_alpha_min;
     r.contact_force = contact_report.force;
     r.friction_iters = friction_iters;
+    r.contact_broad_phase_s = contact_report.timings.broad_phase_s;
+    r.contact_eval_s = contact_report.timings.evaluation_s;
+    r.contact_ccd_s = contact_report.timings.ccd_s;
   }
   r.step_s = timer.seconds();
   return r;

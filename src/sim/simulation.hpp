@@ -52,6 +52,7 @@ struct StepReport {
   double min_distance = 0, barrier_energy = 0, ccd_alpha_min = 0;
   int friction_iters = 0;
   std::array<double, 3> contact_force{0, 0, 0};
+  double contact_broad_phase_s = 0, contact_eval_s = 0, contact_ccd_s = 0;
   double step_s = 0;
   double total_energy() const { return kinetic + elastic + potential; }
 };

@@ -235,6 +235,24 @@ TYPED_TEST(MaterialNeoHookeanTest, SmallStrainMatchesHookesLaw) {
   }
 }
 
+// E = 4e12 at strains 1e-12..1e-6 (the paper's slope box): the neo-Hookean
+// energy keeps its relative accuracy against the small-strain energy (the
+// direct form mu/2 (|F|^2 - d) - mu log J loses ~mu * 1e-16 absolute, which
+// is 1e6 times the strain energy at 1e-12), so a line search can compare
+// energies at tiny strains.
+TYPED_TEST(MaterialNeoHookeanTest, EnergyAccurateAtTinyStrainsOfStiffMaterials) {
+  constexpr int dim = TypeParam::value;
+  std::mt19937 rng(5);
+  const LameParameters p = lame_from_young(4e12, 0.2);
+  for (double scale : {1e-12, 1e-9, 1e-6}) {
+    const Mat<dim> G = random_matrix<dim>(rng, scale), F = Mat<dim>::Identity() + G;
+    const double w_lin = LinearElastic::energy<dim>(F, p);
+    const double w_nh = NeoHookean::energy<dim>(F, p);
+    // Neo-Hookean = linear + O(|G|^3) (E |G|^3 relative to E |G|^2: |G|).
+    EXPECT_NEAR(w_nh, w_lin, 1e-6 * w_lin + 10.0 * scale * w_lin) << "strain scale " << scale;
+  }
+}
+
 TEST(MaterialParams, LameFromYoungAndModelNames) {
   const LameParameters p = lame_from_young(2.0e11, 0.25);
   EXPECT_DOUBLE_EQ(p.mu, 2.0e11 / 2.5);
