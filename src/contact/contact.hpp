@@ -21,6 +21,7 @@ struct ContactParams {
   int friction_max_iterations = 20;  // outer friction loop cap per step
   std::vector<double> mu;  // [mpm body * n_fem + fem body]; empty: frictionless
   int force_body = -1;     // FEM body whose contact force is reported (-1: all)
+  bool check_iterates = false;  // debug: every Newton iterate is checked for penetration
 };
 
 template <int dim>

@@ -141,6 +141,7 @@ ContactParams contact_from(const ParameterList& p) {
   }
   const std::string fb = c.get<std::string>("force body");
   cp.force_body = fb.empty() ? -1 : index_of(fem, fb);
+  cp.check_iterates = c.get<bool>("check iterates");
   return cp;
 }
 

@@ -174,6 +174,8 @@ Teuchos::RCP<const ParameterList> scene_schema() {
       .disableRecursiveValidation();
   contact.set("friction iterations", 20, "cap of the outer friction loop per step (paper Algorithm 1), >= 1");
   contact.set("force body", std::string(""), "FEM body whose contact force goes to diagnostics.csv (default: all)");
+  contact.set("check iterates", false,
+              "debug: test every Newton iterate for particles inside FEM bodies; one found is an error");
   return pl;
 }
 

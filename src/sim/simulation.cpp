@@ -84,6 +84,13 @@ Simulation<dim>::Simulation(SimulationSetup<dim> setup, const Teuchos::RCP<const
   if (setup_.contact && mpm_ && mesh_.num_nodes() > 0) {
     contact_ = std::make_unique<Contact<dim>>(mesh_, *setup_.contact);
     contact_->check_initial(mpm_->particles(), x_);
+    if (setup_.contact->check_iterates)
+      newton_->on_iterate = [this](Kokkos::View<const double*, MemSpace> x) {
+        const LO q = contact_->particle_inside_at(x);
+        if (q >= 0)
+          throw SolverError("MPM particle " + std::to_string(q) +
+                            " is inside or on an FEM body at a Newton iterate (Contact/check iterates)");
+      };
   }
   reset_acceleration();
 }
