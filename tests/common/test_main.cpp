@@ -12,6 +12,10 @@ int main(int argc, char** argv) {
   // (which runs the binaries without the test environment) would read the
   // warning as test names. Tests run unbound unless told otherwise.
   setenv("OMP_PROC_BIND", "false", /*overwrite=*/0);
+  // ctest -j2 runs two tests at once: threads that spin at barriers would
+  // starve each other; BLAS threads would fight Kokkos' threads.
+  setenv("OMP_WAIT_POLICY", "PASSIVE", 0);
+  setenv("OPENBLAS_NUM_THREADS", "1", 0);
   int provided = 0;
   MPI_Init_thread(&argc, &argv, MPI_THREAD_FUNNELED, &provided);
   ::testing::InitGoogleTest(&argc, argv);
