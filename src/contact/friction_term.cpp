@@ -25,10 +25,13 @@ LO FrictionTerm<dim>::update_lagged(ConstDofView x, ConstDofView x_ref, double s
   eh_ = eps_v_ * dt;
   x_ref_ = x_ref;
   n_ = act.count;
-  pair_ = Kokkos::View<LO* [2], MemSpace>("friction_pairs", n_);
-  c_ = decltype(c_)("friction_c", n_);
-  T_ = decltype(T_)("friction_T", n_);
-  ml_ = Kokkos::View<double*, MemSpace>("friction_mu_lambda", n_);
+  if (static_cast<LO>(ml_.extent(0)) < n_) {  // capacity grows; outer iterations reuse it
+    const std::size_t cap = static_cast<std::size_t>(n_) * 5 / 4 + 16;
+    pair_ = Kokkos::View<LO* [2], MemSpace>("friction_pairs", cap);
+    c_ = decltype(c_)("friction_c", cap);
+    T_ = decltype(T_)("friction_T", cap);
+    ml_ = Kokkos::View<double*, MemSpace>("friction_mu_lambda", cap);
+  }
   const std::size_t nq = static_cast<std::size_t>(ps.size()) * dim;
   if (xq_.extent(0) != nq) {
     xq_ = Kokkos::View<double*, MemSpace>("friction_xq", nq);

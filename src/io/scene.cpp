@@ -282,9 +282,6 @@ void build_mpm(const Scene& scene, const std::vector<std::string>& mat_names, Si
         bad(key + "/normal", Teuchos::toString(l.get<Array<double>>("normal")), "a finite non-zero normal");
       const Vec<dim> u = n.normalized();
       for (int d = 0; d < dim; ++d) ls.normal[d] = u(d);
-      int axis = 0;
-      u.cwiseAbs().maxCoeff(&axis);
-      ls.normal_axis = axis;
     } else if (ls.kind == LevelSetKind::Sine) {
       ls.height = l.get<double>("height");
       ls.amplitude = l.get<double>("amplitude");

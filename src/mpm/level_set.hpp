@@ -27,7 +27,6 @@ struct LevelSet {
   std::array<double, 3> normal{0, 1, 0};    // half-plane: unit normal into the free side
   std::array<double, 3> box_min{0, 0, 0}, box_max{0, 0, 0};
   std::array<double, 3> velocity{0, 0, 0};  // m/s, constant
-  int normal_axis = 1;                      // half-plane: the axis closest to the normal
   // sine: contour y = height + amplitude cos(2 pi x / wavelength) at t = 0;
   // solid below it (solid_above false) or above it.
   double height = 0, amplitude = 0, wavelength = 1;
