@@ -1,6 +1,11 @@
 #include "io/diagnostics_csv.hpp"
 
+#include <algorithm>
 #include <cerrno>
+#include <cstdlib>
+#include <fstream>
+
+#include "io/atomic_file.hpp"
 #include <cmath>
 #include <cstring>
 #include <stdexcept>
@@ -11,6 +16,44 @@ namespace bfemp {
 DiagnosticsCsv::DiagnosticsCsv(const std::string& path, std::vector<std::string> columns,
                                const std::set<std::string>& integer_columns)
     : path_(path), columns_(std::move(columns)) {
+  check_columns(integer_columns);
+  file_ = std::fopen(path_.c_str(), "w");
+  if (!file_)
+    throw std::runtime_error("diagnostics file '" + path_ + "': cannot open for writing (" + std::strerror(errno) + ")");
+  std::string header;
+  for (std::size_t i = 0; i < columns_.size(); ++i) header += (i ? "," : "") + columns_[i];
+  put(header + "\n");
+}
+
+DiagnosticsCsv::DiagnosticsCsv(const std::string& path, std::vector<std::string> columns,
+                               const std::set<std::string>& integer_columns, long keep_through_step)
+    : path_(path), columns_(std::move(columns)) {
+  check_columns(integer_columns);
+  const std::string where = "diagnostics file '" + path_ + "': ";
+  std::ifstream in(path_);
+  if (!in) throw std::runtime_error(where + "cannot open for appending (missing?)");
+  std::string header, line, kept;
+  std::getline(in, header);
+  std::string want;
+  for (std::size_t i = 0; i < columns_.size(); ++i) want += (i ? "," : "") + columns_[i];
+  if (header != want) throw std::runtime_error(where + "header '" + header + "' differs from this version's columns");
+  kept = header + "\n";
+  while (std::getline(in, line)) {
+    if (line.empty()) continue;
+    char* end = nullptr;
+    const double step = std::strtod(line.c_str(), &end);
+    const auto commas = static_cast<std::size_t>(std::count(line.begin(), line.end(), ','));
+    if (end == line.c_str() || *end != ',' || commas + 1 != columns_.size()) break;  // a torn last row
+    if (step > static_cast<double>(keep_through_step)) break;
+    kept += line + "\n";
+  }
+  in.close();
+  write_file_atomically(path_, kept);
+  file_ = std::fopen(path_.c_str(), "a");
+  if (!file_) throw std::runtime_error(where + "cannot open for appending (" + std::strerror(errno) + ")");
+}
+
+void DiagnosticsCsv::check_columns(const std::set<std::string>& integer_columns) {
   const std::string where = "diagnostics file '" + path_ + "': ";
   if (columns_.empty()) throw std::invalid_argument(where + "no columns, expected at least one");
   std::set<std::string> seen;
@@ -25,13 +68,6 @@ DiagnosticsCsv::DiagnosticsCsv(const std::string& path, std::vector<std::string>
     if (!seen.count(c))
       throw std::invalid_argument(where + "integer column '" + c + "' is not one of the columns");
   for (const std::string& c : columns_) integer_.push_back(integer_columns.count(c) > 0);
-
-  file_ = std::fopen(path_.c_str(), "w");
-  if (!file_)
-    throw std::runtime_error(where + "cannot open for writing (" + std::strerror(errno) + ")");
-  std::string header;
-  for (std::size_t i = 0; i < columns_.size(); ++i) header += (i ? "," : "") + columns_[i];
-  put(header + "\n");
 }
 
 DiagnosticsCsv::~DiagnosticsCsv() {

@@ -18,6 +18,12 @@ class DiagnosticsCsv {
   // in `columns`; std::runtime_error if the file cannot be written.
   DiagnosticsCsv(const std::string& path, std::vector<std::string> columns,
                  const std::set<std::string>& integer_columns = {});
+  // Restart: continues an existing file whose header must equal `columns`;
+  // rows whose first column (the step) exceeds `keep_through_step` are dropped
+  // first (the file is rewritten atomically), then rows are appended. Throws
+  // std::runtime_error naming the file when it is missing or its header differs.
+  DiagnosticsCsv(const std::string& path, std::vector<std::string> columns,
+                 const std::set<std::string>& integer_columns, long keep_through_step);
   ~DiagnosticsCsv();
   DiagnosticsCsv(const DiagnosticsCsv&) = delete;
   DiagnosticsCsv& operator=(const DiagnosticsCsv&) = delete;
@@ -31,6 +37,7 @@ class DiagnosticsCsv {
 
  private:
   void put(const std::string& text);  // write + flush, throws on error
+  void check_columns(const std::set<std::string>& integer_columns);
 
   std::string path_;
   std::vector<std::string> columns_;

@@ -131,6 +131,31 @@ Hdf5FrameWriter::Hdf5FrameWriter(const std::string& path) : path_(path) {
                 "cannot create file");
 }
 
+Hdf5FrameWriter::Hdf5FrameWriter(const std::string& path, int keep_frames) : path_(path) {
+  QuietErrors quiet;
+  Handle fapl(make_fapl(path_), H5Pclose);
+  file_ = check(H5Fopen(path_.c_str(), H5F_ACC_RDWR, fapl.get()), path_, "cannot open for appending");
+  try {
+    for (int i = 0; i < keep_frames; ++i) {
+      const std::string name = frame_group_name(i);
+      if (check(H5Lexists(file_, name.c_str() + 1, H5P_DEFAULT), path_, "cannot query '" + name + "'") <= 0)
+        throw std::runtime_error("HDF5 file '" + path_ + "': frame '" + name +
+                                 "' recorded by the checkpoint is missing");
+    }
+    for (int i = keep_frames;; ++i) {
+      const std::string name = frame_group_name(i);
+      if (check(H5Lexists(file_, name.c_str() + 1, H5P_DEFAULT), path_, "cannot query '" + name + "'") <= 0) break;
+      check(H5Ldelete(file_, name.c_str(), H5P_DEFAULT), path_, "cannot remove '" + name + "'");
+    }
+    if (check(H5Lexists(file_, "mesh", H5P_DEFAULT), path_, "cannot query '/mesh'") > 0)
+      mesh_ = check(H5Gopen2(file_, "/mesh", H5P_DEFAULT), path_, "cannot open '/mesh'");
+    check(H5Fflush(file_, H5F_SCOPE_GLOBAL), path_, "cannot flush");
+  } catch (...) {
+    close_handles();
+    throw;
+  }
+}
+
 Hdf5FrameWriter::~Hdf5FrameWriter() {
   try {
     close();
@@ -177,6 +202,17 @@ void Hdf5FrameWriter::begin_frame(int index, double time, long step) {
   write_scalar_attribute(frame_, "time", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, &time, path_, name);
   write_scalar_attribute(frame_, "step", H5T_STD_I64LE, H5T_NATIVE_LLONG, &step64, path_, name);
   write_scalar_attribute(frame_, "index", H5T_STD_I64LE, H5T_NATIVE_LLONG, &index64, path_, name);
+}
+
+double Hdf5FrameWriter::frame_time(int index) const {
+  const std::string name = frame_group_name(index);
+  const std::string what = "cannot read attribute 'time' of '" + name + "'";
+  QuietErrors quiet;
+  Handle attr(check(H5Aopen_by_name(file_, name.c_str(), "time", H5P_DEFAULT, H5P_DEFAULT), path_, what),
+              H5Aclose);
+  double t = 0.0;
+  check(H5Aread(attr.get(), H5T_NATIVE_DOUBLE, &t), path_, what);
+  return t;
 }
 
 void Hdf5FrameWriter::end_frame() {

@@ -31,6 +31,11 @@ class Hdf5FrameWriter {
  public:
   // Creates (or truncates) the file.
   explicit Hdf5FrameWriter(const std::string& path);
+  // Restart: opens the existing file for writing, keeps frames 0 ..
+  // keep_frames - 1 and /mesh, and unlinks later frame groups (written after
+  // the checkpoint the run continues from). Throws std::runtime_error naming
+  // the file when it is missing or a kept frame is absent.
+  Hdf5FrameWriter(const std::string& path, int keep_frames);
   // Closes any open frame and the file; errors are swallowed (call close() to
   // see them).
   ~Hdf5FrameWriter();
@@ -56,6 +61,8 @@ class Hdf5FrameWriter {
   void close();
 
   const std::string& path() const { return path_; }
+  // Attribute "time" of frame `index` (restart rebuilds the XDMF index).
+  double frame_time(int index) const;
   bool frame_open() const { return frame_ >= 0; }
   // "/frame_%06d".
   static std::string frame_group_name(int index);

@@ -2,6 +2,7 @@
 
 #include <Teuchos_YamlParameterListHelpers.hpp>
 #include <filesystem>
+#include <set>
 #include <sstream>
 
 #include "io/atomic_file.hpp"
@@ -35,11 +36,20 @@ std::string prepare_dir(const std::string& dir) {
 }  // namespace
 
 template <int dim>
-RunOutput<dim>::RunOutput(const std::string& dir, const Scene& scene, const Simulation<dim>& sim)
-    : dir_(prepare_dir(dir)),
-      h5_(dir + "/bfemp.h5"),
-      xdmf_(dir + "/bfemp.xdmf", "bfemp.h5"),
-      csv_(dir + "/diagnostics.csv", diagnostics_columns(), {"step", "newton_iters", "linear_iters", "active_grid_nodes", "contact_pairs", "friction_iters"}) {
+RunOutput<dim>::RunOutput(const std::string& dir, const Scene& scene, const Simulation<dim>& sim,
+                          const OutputResume* resume)
+    : dir_(prepare_dir(dir)), xdmf_(dir + "/bfemp.xdmf", "bfemp.h5") {
+  const std::set<std::string> ints = {"step", "newton_iters", "linear_iters", "active_grid_nodes", "contact_pairs",
+                                      "friction_iters"};
+  if (resume) {
+    h5_ = std::make_unique<Hdf5FrameWriter>(dir + "/bfemp.h5", resume->frames);
+    csv_ = std::make_unique<DiagnosticsCsv>(dir + "/diagnostics.csv", diagnostics_columns(), ints, resume->step);
+    for (int i = 0; i < resume->frames; ++i) xdmf_.add_frame(xdmf_frame(sim, i, h5_->frame_time(i)));
+    frame_ = resume->frames;
+  } else {
+    h5_ = std::make_unique<Hdf5FrameWriter>(dir + "/bfemp.h5");
+    csv_ = std::make_unique<DiagnosticsCsv>(dir + "/diagnostics.csv", diagnostics_columns(), ints);
+  }
   std::ostringstream yaml;
   yaml << std::showpoint;
   Teuchos::writeParameterListToYamlOStream(scene.params, yaml);
@@ -48,7 +58,42 @@ RunOutput<dim>::RunOutput(const std::string& dir, const Scene& scene, const Simu
   std::vector<long long> conn(cells.size());
   for (std::size_t e = 0; e < cells.extent(0); ++e)
     for (int a = 0; a <= dim; ++a) conn[e * (dim + 1) + a] = cells(e, a);
-  if (!conn.empty()) h5_.write_static("cells", conn.data(), cells.extent(0), dim + 1);
+  if (!conn.empty() && !resume) h5_->write_static("cells", conn.data(), cells.extent(0), dim + 1);
+}
+
+template <int dim>
+XdmfFrame RunOutput<dim>::xdmf_frame(const Simulation<dim>& sim, int index, double time) const {
+  const auto& mesh = sim.mesh();
+  const std::size_t nn = mesh.num_nodes(), ne = mesh.num_cells();
+  XdmfFrame frame{time, {}};
+  if (nn > 0) {
+    XdmfGrid g;
+    g.name = "fem";
+    g.group = Hdf5FrameWriter::frame_group_name(index);
+    g.topology = {dim == 2 ? "Triangle" : "Tetrahedron", ne, dim + 1, "/mesh/cells"};
+    g.num_nodes = nn;
+    g.dim = dim;
+    g.node_attributes = {{"velocity", "velocities", dim}};
+    g.cell_attributes = {{"von_mises", "von_mises", 1}, {"J", "J", 1}};
+    frame.grids.push_back(g);
+  }
+  if (const auto* mpm = sim.mpm()) {
+    const std::size_t np = mpm->particles().size();
+    XdmfGrid g;
+    g.name = "particles";
+    g.group = Hdf5FrameWriter::frame_group_name(index);
+    g.topology = {"Polyvertex", np, 1, ""};
+    g.num_nodes = np;
+    g.dim = dim;
+    g.geometry = "particle_positions";
+    g.node_attributes = {{"velocity", "particle_velocities", dim},
+                         {"von_mises", "particle_von_mises", 1},
+                         {"J", "particle_J", 1},
+                         {"body", "particle_body", 1, true}};
+    if (sim.contact()) g.node_attributes.push_back({"contact_force", "particle_contact_force", dim});
+    frame.grids.push_back(g);
+  }
+  return frame;
 }
 
 template <int dim>
@@ -62,22 +107,12 @@ void RunOutput<dim>::write_frame(const Simulation<dim>& sim) {
   sim.element_von_mises(vm);
   auto Jh = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), J);
   auto vmh = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), vm);
-  h5_.begin_frame(frame_, sim.time(), sim.step_index());
-  XdmfFrame frame{sim.time(), {}};
+  h5_->begin_frame(frame_, sim.time(), sim.step_index());
   if (nn > 0) {
-    h5_.write_array("positions", x.data(), nn, dim);
-    h5_.write_array("velocities", v.data(), nn, dim);
-    h5_.write_array("von_mises", vmh.data(), ne, 1);
-    h5_.write_array("J", Jh.data(), ne, 1);
-    XdmfGrid g;
-    g.name = "fem";
-    g.group = Hdf5FrameWriter::frame_group_name(frame_);
-    g.topology = {dim == 2 ? "Triangle" : "Tetrahedron", ne, dim + 1, "/mesh/cells"};
-    g.num_nodes = nn;
-    g.dim = dim;
-    g.node_attributes = {{"velocity", "velocities", dim}};
-    g.cell_attributes = {{"von_mises", "von_mises", 1}, {"J", "J", 1}};
-    frame.grids.push_back(g);
+    h5_->write_array("positions", x.data(), nn, dim);
+    h5_->write_array("velocities", v.data(), nn, dim);
+    h5_->write_array("von_mises", vmh.data(), ne, 1);
+    h5_->write_array("J", Jh.data(), ne, 1);
   }
   if (const auto* mpm = sim.mpm()) {
     const auto& p = mpm->particles();
@@ -90,35 +125,22 @@ void RunOutput<dim>::write_frame(const Simulation<dim>& sim) {
     auto pJh = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), pJ);
     auto pvmh = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), pvm);
     std::vector<long long> body(pb.data(), pb.data() + np);
-    h5_.write_array("particle_positions", px.data(), np, dim);
-    h5_.write_array("particle_velocities", pv.data(), np, dim);
-    h5_.write_array("particle_von_mises", pvmh.data(), np, 1);
-    h5_.write_array("particle_J", pJh.data(), np, 1);
-    h5_.write_array("particle_body", body.data(), np, 1);
+    h5_->write_array("particle_positions", px.data(), np, dim);
+    h5_->write_array("particle_velocities", pv.data(), np, dim);
+    h5_->write_array("particle_von_mises", pvmh.data(), np, 1);
+    h5_->write_array("particle_J", pJh.data(), np, 1);
+    h5_->write_array("particle_body", body.data(), np, 1);
     const auto* contact = sim.contact();
     if (contact && contact->particle_forces().extent(0) == np * dim) {
       auto f = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), contact->particle_forces());
-      h5_.write_array("particle_contact_force", f.data(), np, dim);
+      h5_->write_array("particle_contact_force", f.data(), np, dim);
     } else if (contact) {
       const std::vector<double> zero(np * dim, 0.0);  // frame 0: no step solved yet
-      h5_.write_array("particle_contact_force", zero.data(), np, dim);
+      h5_->write_array("particle_contact_force", zero.data(), np, dim);
     }
-    XdmfGrid g;
-    g.name = "particles";
-    g.group = Hdf5FrameWriter::frame_group_name(frame_);
-    g.topology = {"Polyvertex", np, 1, ""};
-    g.num_nodes = np;
-    g.dim = dim;
-    g.geometry = "particle_positions";
-    g.node_attributes = {{"velocity", "particle_velocities", dim},
-                         {"von_mises", "particle_von_mises", 1},
-                         {"J", "particle_J", 1},
-                         {"body", "particle_body", 1, true}};
-    if (contact) g.node_attributes.push_back({"contact_force", "particle_contact_force", dim});
-    frame.grids.push_back(g);
   }
-  h5_.end_frame();
-  xdmf_.add_frame(frame);
+  h5_->end_frame();
+  xdmf_.add_frame(xdmf_frame(sim, frame_, sim.time()));
   ++frame_;
 }
 

@@ -20,20 +20,33 @@ namespace bfemp {
 const std::vector<std::string>& diagnostics_columns();
 std::vector<double> diagnostics_row(const StepReport& r);
 
+// Restart into the run's own directory: keep `frames` frames and the
+// diagnostics rows through `step`, then append.
+struct OutputResume {
+  int frames = 0;
+  long step = 0;
+};
+
 template <int dim>
 class RunOutput {
  public:
-  RunOutput(const std::string& dir, const Scene& scene, const Simulation<dim>& sim);
+  // A new output (files created or truncated), or with `resume` the
+  // continuation of the directory's existing files.
+  RunOutput(const std::string& dir, const Scene& scene, const Simulation<dim>& sim,
+            const OutputResume* resume = nullptr);
   void write_frame(const Simulation<dim>& sim);
-  void write_diagnostics(const StepReport& r) { csv_.write_row(diagnostics_row(r)); }
-  void close() { h5_.close(); }
+  void write_diagnostics(const StepReport& r) { csv_->write_row(diagnostics_row(r)); }
+  void close() { h5_->close(); }
   int frames_written() const { return frame_; }
+  const std::string& dir() const { return dir_; }
 
  private:
+  XdmfFrame xdmf_frame(const Simulation<dim>& sim, int index, double time) const;
+
   std::string dir_;
-  Hdf5FrameWriter h5_;
+  std::unique_ptr<Hdf5FrameWriter> h5_;
   XdmfSeriesWriter xdmf_;
-  DiagnosticsCsv csv_;
+  std::unique_ptr<DiagnosticsCsv> csv_;
   int frame_ = 0;
 };
 

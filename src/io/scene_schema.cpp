@@ -147,6 +147,8 @@ Teuchos::RCP<const ParameterList> scene_schema() {
   auto& out = pl->sublist("Output", false, "output frames and progress");
   out.set("frame every", 10, "steps between HDF5/XDMF frames (frame 0 is the initial state)");
   out.set("progress every", 10, "steps between progress lines (0: none)");
+  out.set("checkpoint every", 0,
+          "steps between restart checkpoints (checkpoint.h5; 0: only at the end and on SIGINT/SIGTERM), >= 0");
   pl->sublist("Materials", false, "named materials").disableRecursiveValidation();
   pl->sublist("FEM Bodies", false, "named FEM bodies").disableRecursiveValidation();
   auto& mpm = pl->sublist("MPM", false, "background grid and transfers of the MPM bodies");

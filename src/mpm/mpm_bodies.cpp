@@ -92,6 +92,14 @@ LO MpmBodies<dim>::begin_step(LO first, long step) {
 }
 
 template <int dim>
+void MpmBodies<dim>::restore_grid(const GridSpec<dim>& grid, int extensions) {
+  if (!(grid.dx > 0)) throw std::invalid_argument("restart: MPM grid spacing " + std::to_string(grid.dx) + ", expected > 0");
+  setup_.grid = grid;
+  extensions_ = extensions;
+  system_node_ = Kokkos::View<LO*, MemSpace>("mpm_system_node", setup_.grid.num_nodes());
+}
+
+template <int dim>
 void MpmBodies<dim>::fill_system(Kokkos::View<double*, MemSpace> x, Kokkos::View<double*, MemSpace> v,
                                  Kokkos::View<double*, MemSpace> mass) const {
   const auto grid = setup_.grid;

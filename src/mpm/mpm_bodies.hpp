@@ -61,6 +61,8 @@ class MpmBodies {
   TransferScheme scheme() const { return setup_.scheme; }
   LO active_nodes() const { return active_; }
   int domain_extensions() const { return extensions_; }  // times the grid grew
+  // Restart: the grid as a checkpoint recorded it (after its extensions).
+  void restore_grid(const GridSpec<dim>& grid, int extensions);
   // System node of each grid node this step (-1: inactive).
   Kokkos::View<const LO*, MemSpace> system_node() const { return system_node_; }
 

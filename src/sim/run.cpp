@@ -1,22 +1,136 @@
 #include "sim/run.hpp"
 
 #include <Kokkos_Timer.hpp>
+#include <Teuchos_CommHelpers.hpp>
+#include <Teuchos_YamlParameterListHelpers.hpp>
 #include <cmath>
+#include <filesystem>
 #include <iomanip>
 #include <ostream>
+#include <sstream>
 
 #include "io/run_output.hpp"
+#include "sim/interrupt.hpp"
 
 namespace bfemp {
 
 namespace {
 
+const char* kRestartKeys[] = {"Time/end time", "Output/", "Newton/", "Linear Solver/", "Contact/friction iterations",
+                              "Contact/check iterates"};
+
+std::string join_lines(const std::vector<std::string>& v) {
+  std::string s;
+  for (const auto& x : v) s += x + "\n";
+  return s;
+}
+
+std::vector<std::string> split_lines(const std::string& s) {
+  std::vector<std::string> out;
+  std::istringstream in(s);
+  for (std::string line; std::getline(in, line);)
+    if (!line.empty()) out.push_back(line);
+  return out;
+}
+
+template <int dim>
+Checkpoint make_checkpoint(const Scene& scene, const RunOptions& opt, const Simulation<dim>& sim, int frames) {
+  const SimulationState<dim> st = sim.state();
+  Checkpoint c;
+  c.time = st.time;
+  c.step = st.step;
+  c.frames = frames;
+  c.dim = dim;
+  std::ostringstream resolved;
+  resolved << std::showpoint << std::setprecision(17);
+  Teuchos::writeParameterListToYamlOStream(scene.params, resolved);
+  c.texts["scene_resolved"] = resolved.str();
+  c.texts["scene_source"] = opt.scene_source.empty() ? resolved.str() : opt.scene_source;
+  c.texts["overrides"] = opt.scene_source.empty() ? std::string() : join_lines(opt.overrides);
+  c.texts["base_dir"] = std::filesystem::absolute(scene.base_dir.empty() ? "." : scene.base_dir).string();
+  c.put("fem_x", st.fem_x, dim);
+  c.put("fem_v", st.fem_v, dim);
+  c.put("fem_a", st.fem_a, dim);
+  if (st.has_mpm) {
+    c.put("particle_x", st.x, dim);
+    c.put("particle_v", st.v, dim);
+    c.put("particle_mass", st.mass);
+    c.put("particle_volume0", st.volume0);
+    c.put("particle_F", st.F, dim * dim);
+    c.put("particle_C", st.C, dim * dim);
+    c.put("particle_body", st.body);
+    c.put("particle_material", st.material);
+    c.put("grid_origin", std::vector<double>(st.grid_origin.begin(), st.grid_origin.end()));
+    c.put("grid_cells", std::vector<long long>(st.grid_cells.begin(), st.grid_cells.end()));
+    c.put("grid_dx", std::vector<double>{st.grid_dx});
+    c.put("grid_extensions", std::vector<long long>{st.grid_extensions});
+  }
+  return c;
+}
+
+template <int dim>
+SimulationState<dim> checkpoint_state(const Checkpoint& c) {
+  SimulationState<dim> st;
+  st.time = c.time;
+  st.step = c.step;
+  st.fem_x = c.real("fem_x");
+  st.fem_v = c.real("fem_v");
+  st.fem_a = c.real("fem_a");
+  st.has_mpm = c.has("particle_x");
+  if (st.has_mpm) {
+    st.x = c.real("particle_x");
+    st.v = c.real("particle_v");
+    st.mass = c.real("particle_mass");
+    st.volume0 = c.real("particle_volume0");
+    st.F = c.real("particle_F");
+    st.C = c.real("particle_C");
+    st.body = c.ints("particle_body");
+    st.material = c.ints("particle_material");
+    const auto& o = c.real("grid_origin", dim);
+    const auto& n = c.ints("grid_cells", dim);
+    for (int d = 0; d < dim; ++d) {
+      st.grid_origin[d] = o[d];
+      st.grid_cells[d] = static_cast<int>(n[d]);
+    }
+    st.grid_dx = c.real("grid_dx", 1)[0];
+    st.grid_extensions = static_cast<int>(c.ints("grid_extensions", 1)[0]);
+  }
+  return st;
+}
+
+void accumulate(RunSummary& s, const StepReport& r) {
+  s.steps++;
+  s.newton_iterations += r.newton.iterations;
+  s.linear_iterations += r.newton.linear_iterations;
+  s.assembly_s += r.newton.assembly_s;
+  s.solve_s += r.newton.solve_s;
+  s.line_search_s += r.newton.line_search_s;
+  s.contact_broad_phase_s += r.contact_broad_phase_s;
+  s.contact_eval_s += r.contact_eval_s;
+  s.contact_ccd_s += r.contact_ccd_s;
+}
+
+// The signal any rank received (every rank stops after the same step).
+int global_signal(const Teuchos::RCP<const Comm>& comm) {
+  int mine = pending_signal(), any = mine;
+  if (comm->getSize() > 1) Teuchos::reduceAll(*comm, Teuchos::REDUCE_MAX, mine, Teuchos::outArg(any));
+  return any;
+}
+
 template <int dim>
 RunSummary run_dim(const Scene& scene, const std::string& dir, const Teuchos::RCP<const Comm>& comm,
-                   std::ostream& log) {
+                   std::ostream& log, const RunOptions& opt) {
   Kokkos::Timer wall;
   const RunControl rc = scene.run_control();
+  const int checkpoint_every = scene.params.sublist("Output").get<int>("checkpoint every");
+  if (checkpoint_every < 0)
+    throw std::invalid_argument("scene key 'Output/checkpoint every' = " + std::to_string(checkpoint_every) +
+                                ": expected >= 0 (0: checkpoints only at the end and on interruption)");
+  if (opt.restart && opt.restart->dim != dim)
+    throw std::invalid_argument("restart: the checkpoint is " + std::to_string(opt.restart->dim) +
+                                "D, the scene " + std::to_string(dim) + "D");
   Simulation<dim> sim(build_setup<dim>(scene), comm);
+  if (opt.restart) sim.restore(checkpoint_state<dim>(*opt.restart));
   const auto& mesh = sim.mesh();
   log << "FEM: " << mesh.num_nodes() << " nodes, " << mesh.num_cells() << " elements, "
       << mesh.num_nodes() * dim << " DOFs";
@@ -24,34 +138,51 @@ RunSummary run_dim(const Scene& scene, const std::string& dir, const Teuchos::RC
     log << "; MPM: " << mpm->particles().size() << " particles, " << transfer_scheme_name(mpm->scheme())
         << ", grid " << mpm->grid().num_nodes() << " nodes (dx " << mpm->grid().dx << ")";
   log << "; linear solver: " << sim.newton().linear_solver().describe() << "\n";
-  RunOutput<dim> out(dir, scene, sim);
-  out.write_frame(sim);
+  OutputResume resume;
+  if (opt.restart && opt.append) resume = {opt.restart->frames, opt.restart->step};
+  RunOutput<dim> out(dir, scene, sim, opt.restart && opt.append ? &resume : nullptr);
+  if (!(opt.restart && opt.append)) out.write_frame(sim);
+  if (opt.restart)
+    log << "restart: from step " << opt.restart->step << " (t = " << opt.restart->time << " s), "
+        << (opt.append ? "appending to " : "new output in ") << dir << "\n";
+  const std::string ck_path = dir + "/checkpoint.h5";
+  RunSummary s;
+  s.contact = sim.contact() != nullptr;
+  auto checkpoint = [&] {
+    write_checkpoint(ck_path, make_checkpoint(scene, opt, sim, out.frames_written()));
+    s.checkpoints++;
+  };
   const double dt = scene.params.sublist("Time").get<double>("dt");
   const long n_steps = static_cast<long>(std::ceil(rc.end_time / dt - 1e-9));
-  RunSummary s;
-  for (long n = 0; n < n_steps; ++n) {
+  const long first = sim.step_index();
+  std::unique_ptr<InterruptGuard> guard;
+  if (opt.handle_signals) guard = std::make_unique<InterruptGuard>();
+  for (long n = first; n < n_steps; ++n) {
     const StepReport r = sim.step();
     out.write_diagnostics(r);
-    s.steps++;
-    s.newton_iterations += r.newton.iterations;
-    s.linear_iterations += r.newton.linear_iterations;
-    s.assembly_s += r.newton.assembly_s;
-    s.solve_s += r.newton.solve_s;
-    s.line_search_s += r.newton.line_search_s;
-    s.contact = sim.contact() != nullptr;
-    s.contact_broad_phase_s += r.contact_broad_phase_s;
-    s.contact_eval_s += r.contact_eval_s;
-    s.contact_ccd_s += r.contact_ccd_s;
-    if ((n + 1) % rc.output_every == 0 || n + 1 == n_steps) out.write_frame(sim);
+    accumulate(s, r);
+    const int sig = guard ? global_signal(comm) : 0;
+    const bool framed = (n + 1) % rc.output_every == 0 || n + 1 == n_steps || sig;
+    if (framed) out.write_frame(sim);
+    if (sig || (checkpoint_every > 0 && (n + 1) % checkpoint_every == 0 && n + 1 < n_steps)) checkpoint();
     if (rc.progress_every > 0 && ((n + 1) % rc.progress_every == 0 || n + 1 == n_steps)) {
       const double el = wall.seconds();
+      const long done = n + 1 - first;
       log << "step " << std::setw(6) << r.step << "/" << n_steps << "  t " << std::setw(10) << r.time
           << "  newton " << std::setw(3) << r.newton.iterations << "  E " << std::setw(12)
           << r.total_energy() << "  min J " << std::setw(8) << r.min_J << "  wall " << el
-          << " s  eta " << el / (n + 1) * (n_steps - n - 1) << " s\n"
+          << " s  eta " << el / done * (n_steps - n - 1) << " s\n"
           << std::flush;
     }
+    if (sig) {
+      out.close();
+      std::ostringstream msg;
+      msg << (sig == SIGINT ? "SIGINT" : sig == SIGTERM ? "SIGTERM" : "signal") << " after step " << r.step
+          << " (t = " << r.time << " s): frame and checkpoint written; continue with: bfemp restart " << dir;
+      throw Interrupted(sig, msg.str());
+    }
   }
+  checkpoint();
   out.close();
   s.frames = out.frames_written();
   s.wall_s = wall.seconds();
@@ -60,9 +191,29 @@ RunSummary run_dim(const Scene& scene, const std::string& dir, const Teuchos::RC
 
 }  // namespace
 
+void check_restart_override(const std::string& assignment) {
+  const std::string key = assignment.substr(0, assignment.find('='));
+  for (const char* allowed : kRestartKeys) {
+    const std::string a = allowed;
+    if (a.back() == '/' ? key.rfind(a, 0) == 0 : key == a) return;
+  }
+  std::string list;
+  for (const char* allowed : kRestartKeys) list += std::string(list.empty() ? "" : ", ") + allowed;
+  throw std::invalid_argument("restart: --set '" + key + "' would change the checkpointed state or its shape; " +
+                              "a restart may change only " + list);
+}
+
+Scene checkpoint_scene(const Checkpoint& c, const std::vector<std::string>& extra) {
+  for (const auto& e : extra) check_restart_override(e);
+  std::vector<std::string> overrides = split_lines(c.text("overrides"));
+  overrides.insert(overrides.end(), extra.begin(), extra.end());
+  return load_scene_from_string(c.text("scene_source"), c.text("base_dir"), overrides);
+}
+
 RunSummary run_scene(const Scene& scene, const std::string& dir, const Teuchos::RCP<const Comm>& comm,
-                     std::ostream& log) {
-  RunSummary s = scene.dim() == 2 ? run_dim<2>(scene, dir, comm, log) : run_dim<3>(scene, dir, comm, log);
+                     std::ostream& log, const RunOptions& options) {
+  RunSummary s = scene.dim() == 2 ? run_dim<2>(scene, dir, comm, log, options)
+                                  : run_dim<3>(scene, dir, comm, log, options);
   log << "\nsummary\n"
       << "  steps               " << s.steps << "\n"
       << "  Newton iterations   " << s.newton_iterations << " (" << std::setprecision(3)
@@ -74,9 +225,9 @@ RunSummary run_scene(const Scene& scene, const std::string& dir, const Teuchos::
   if (s.contact)
     log << "  contact: broad phase " << s.contact_broad_phase_s << " s, pair evaluation " << s.contact_eval_s
         << " s, CCD " << s.contact_ccd_s << " s (within the times above)\n";
-  log
-      << "  wall time           " << s.wall_s << " s\n"
-      << "  frames written      " << s.frames << " (" << dir << "/bfemp.xdmf)\n";
+  log << "  wall time           " << s.wall_s << " s\n"
+      << "  frames written      " << s.frames << " (" << dir << "/bfemp.xdmf)\n"
+      << "  checkpoint          " << dir << "/checkpoint.h5 (continue with: bfemp restart " << dir << ")\n";
   return s;
 }
 

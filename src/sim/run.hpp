@@ -1,9 +1,15 @@
 #pragma once
-// Runs a loaded scene to its end time: builds the simulation, writes frames and
-// diagnostics, prints progress and a summary table.
+// Runs a loaded scene to its end time: builds the simulation, writes frames,
+// diagnostics and restart checkpoints, prints progress and a summary table.
+// Restart: the same loop continued from a checkpoint (bfemp restart).
+// Interruption: with RunOptions::handle_signals, SIGINT/SIGTERM finish the
+// current step, write a frame and a checkpoint, close the files and throw
+// Interrupted (the driver exits 130 / 143).
 #include <iosfwd>
 #include <string>
+#include <vector>
 
+#include "io/checkpoint.hpp"
 #include "io/scene.hpp"
 
 namespace bfemp {
@@ -16,9 +22,31 @@ struct RunSummary {
   bool contact = false;
   double contact_broad_phase_s = 0, contact_eval_s = 0, contact_ccd_s = 0;  // parts of the above
   int frames = 0;
+  int checkpoints = 0;
+};
+
+struct RunOptions {
+  // The scene file's text and the --set overrides applied to it: stored in
+  // checkpoints so that a restart rebuilds exactly this scene (empty source:
+  // the resolved scene is written out instead).
+  std::string scene_source;
+  std::vector<std::string> overrides;
+  const Checkpoint* restart = nullptr;  // continue from this state
+  bool append = false;                  // restart into the checkpoint's own directory
+  bool handle_signals = false;          // SIGINT / SIGTERM: checkpoint, then Interrupted
 };
 
 RunSummary run_scene(const Scene& scene, const std::string& output_dir,
-                     const Teuchos::RCP<const Comm>& comm, std::ostream& log);
+                     const Teuchos::RCP<const Comm>& comm, std::ostream& log, const RunOptions& options = {});
+
+// The keys `bfemp restart --set` may change: those that leave the state's
+// shape alone (end time, output, Newton and linear-solver settings, the
+// friction-loop cap and the iterate check). Throws std::invalid_argument
+// naming the key otherwise.
+void check_restart_override(const std::string& assignment);
+
+// The scene a checkpoint was written from, with `extra` overrides applied
+// after its own (each checked by check_restart_override).
+Scene checkpoint_scene(const Checkpoint& c, const std::vector<std::string>& extra);
 
 }  // namespace bfemp

@@ -57,6 +57,25 @@ struct StepReport {
   double total_energy() const { return kinetic + elastic + potential; }
 };
 
+// Everything that carries over from one step to the next, on the host (restart
+// checkpoints): FEM node-interleaved x, v, a; every particle field row-major
+// (x, v: np x dim; F, C: np x dim*dim); the MPM grid as extended; t and n.
+// Everything else (graph, stencils, contact pairs, lagged friction) is rebuilt
+// from these at the start of each step.
+template <int dim>
+struct SimulationState {
+  double time = 0;
+  long step = 0;
+  std::vector<double> fem_x, fem_v, fem_a;
+  bool has_mpm = false;
+  std::vector<double> x, v, mass, volume0, F, C;
+  std::vector<long long> body, material;
+  std::array<double, dim> grid_origin{};
+  std::array<int, dim> grid_cells{};
+  double grid_dx = 0;
+  int grid_extensions = 0;
+};
+
 template <int dim>
 class Simulation {
  public:
@@ -65,6 +84,12 @@ class Simulation {
 
   StepReport step();                 // advance by dt; throws SolverError naming the step
   StepReport diagnostics() const;    // energies, momentum, min J of the current state
+
+  // Restart: the state after the last step, and its restoration into a
+  // simulation built from the same scene (std::invalid_argument naming the
+  // field when the sizes do not match: the scene is not the checkpoint's).
+  SimulationState<dim> state() const;
+  void restore(const SimulationState<dim>& s);
 
   double time() const { return time_; }
   long step_index() const { return step_; }

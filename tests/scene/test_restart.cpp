@@ -1,0 +1,365 @@
+// Restart and interruption, through the real executable (1 OpenMP thread):
+//  - N steps + `bfemp restart` + N steps equals 2N uninterrupted steps
+//    bit-for-bit (every checkpointed field, every diagnostics value but the
+//    timings) for an FEM scene, an MPM scene whose grid extends before and
+//    after the restart, and a contact scene with friction (backward Euler and
+//    Newmark); the same into a new directory (--output);
+//  - SIGTERM / SIGINT mid-run: exit 143 / 130, a checkpoint, a line naming the
+//    restart command, and the restarted run equals the uninterrupted one;
+//  - SIGKILL mid-run: every frame the XDMF lists is readable with the sizes
+//    it states, and the restart from the last periodic checkpoint drops the
+//    later frames and rows and still equals the uninterrupted run;
+//  - restart --set of a key that changes the state is refused (exit 2).
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <fcntl.h>
+
+#include <chrono>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <regex>
+#include <sstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "io/checkpoint.hpp"
+#include "io/hdf5_frames.hpp"
+
+extern char** environ;
+
+namespace {
+
+namespace fs = std::filesystem;
+const std::string exe = std::string(BFEMP_BINARY_DIR) + "/drivers/bfemp";
+const std::string root = std::string(BFEMP_BINARY_DIR) + "/test_runs/restart";
+const std::string src = BFEMP_SOURCE_DIR;
+
+std::string dir_of(const std::string& tag) { return root + "/" + tag; }
+
+// Runs bfemp with `args` (already quoted); returns the exit status.
+int run_bfemp(const std::string& args, const std::string& log) {
+  fs::create_directories(root);
+  const std::string cmd = "OMP_NUM_THREADS=1 OMP_PROC_BIND=false OPENBLAS_NUM_THREADS=1 " + exe + " " + args + " > " +
+                          log + " 2>&1";
+  const int st = std::system(cmd.c_str());
+  return WIFEXITED(st) ? WEXITSTATUS(st) : 1000 + st;
+}
+
+std::string slurp(const std::string& path) {
+  std::ifstream in(path);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+std::string fresh(const std::string& tag) {
+  fs::remove_all(dir_of(tag));
+  return dir_of(tag);
+}
+
+// Every field, attribute and the resolved scene equal bit for bit.
+void expect_same_checkpoint(const std::string& a, const std::string& b) {
+  const bfemp::Checkpoint ca = bfemp::read_checkpoint(a + "/checkpoint.h5");
+  const bfemp::Checkpoint cb = bfemp::read_checkpoint(b + "/checkpoint.h5");
+  EXPECT_EQ(ca.step, cb.step);
+  EXPECT_EQ(std::memcmp(&ca.time, &cb.time, sizeof(double)), 0) << ca.time << " vs " << cb.time;
+  ASSERT_EQ(ca.arrays.size(), cb.arrays.size());
+  for (const auto& [name, x] : ca.arrays) {
+    ASSERT_TRUE(cb.has(name)) << name;
+    const auto& y = cb.arrays.at(name);
+    ASSERT_EQ(x.rows, y.rows) << name;
+    ASSERT_EQ(x.integer, y.integer) << name;
+    if (x.integer) {
+      EXPECT_EQ(x.ints, y.ints) << name;
+    } else {
+      ASSERT_EQ(x.real.size(), y.real.size()) << name;
+      std::size_t diff = 0;
+      for (std::size_t i = 0; i < x.real.size(); ++i) diff += std::memcmp(&x.real[i], &y.real[i], sizeof(double)) != 0;
+      EXPECT_EQ(diff, 0u) << name << ": " << diff << " of " << x.real.size() << " values differ";
+    }
+  }
+}
+
+std::vector<std::vector<std::string>> csv(const std::string& path) {
+  std::vector<std::vector<std::string>> rows;
+  std::istringstream in(slurp(path));
+  for (std::string line; std::getline(in, line);) {
+    std::vector<std::string> r;
+    std::istringstream ls(line);
+    for (std::string f; std::getline(ls, f, ',');) r.push_back(f);
+    rows.push_back(r);
+  }
+  return rows;
+}
+
+// diagnostics.csv of `b` (a restarted run) equals `a` row for row from step
+// `from` on (all of it when from = 1), but for the timing columns.
+void expect_same_diagnostics(const std::string& a, const std::string& b, long from = 1) {
+  const auto ra = csv(a + "/diagnostics.csv"), rb = csv(b + "/diagnostics.csv");
+  ASSERT_FALSE(ra.empty());
+  ASSERT_EQ(ra[0], rb[0]) << "headers";
+  std::vector<bool> timing(ra[0].size());
+  for (std::size_t c = 0; c < ra[0].size(); ++c)
+    timing[c] = ra[0][c] == "assembly_s" || ra[0][c] == "solve_s" || ra[0][c] == "step_s";
+  std::size_t ia = 1;
+  while (ia < ra.size() && std::stol(ra[ia][0]) < from) ++ia;
+  ASSERT_EQ(ra.size() - ia, rb.size() - 1) << "rows from step " << from;
+  for (std::size_t ib = 1; ib < rb.size(); ++ib, ++ia)
+    for (std::size_t c = 0; c < ra[0].size(); ++c)
+      if (!timing[c]) {
+        EXPECT_EQ(ra[ia][c], rb[ib][c]) << "step " << ra[ia][0] << " column " << ra[0][c];
+      }
+}
+
+struct Case {
+  std::string tag, scene, sets;
+  double dt;
+  int n;  // steps before the restart; the run goes to 2n
+};
+
+std::string end_time(const Case& c, double steps) {
+  std::ostringstream s;
+  s.precision(17);
+  s << "--set 'Time/end time=" << (steps - 0.25) * c.dt << "'";
+  return s.str();
+}
+
+// Returns the checkpoint after the first n steps.
+bfemp::Checkpoint restart_equals_uninterrupted(const Case& c) {
+  const std::string full = fresh(c.tag + "_full"), half = fresh(c.tag + "_half"), other = fresh(c.tag + "_other");
+  EXPECT_EQ(run_bfemp("run " + c.scene + " " + c.sets + " " + end_time(c, 2 * c.n) + " -o " + full, full + ".log"), 0)
+      << slurp(full + ".log");
+  EXPECT_EQ(run_bfemp("run " + c.scene + " " + c.sets + " " + end_time(c, c.n) + " -o " + half, half + ".log"), 0)
+      << slurp(half + ".log");
+  const bfemp::Checkpoint mid = bfemp::read_checkpoint(half + "/checkpoint.h5");
+  EXPECT_EQ(mid.step, c.n);
+  // Into a new directory first (the checkpoint in `half` stays as it is) ...
+  EXPECT_EQ(run_bfemp("restart " + half + " " + end_time(c, 2 * c.n) + " -o " + other, other + ".log"), 0)
+      << slurp(other + ".log");
+  // ... then appending to the run's own directory.
+  EXPECT_EQ(run_bfemp("restart " + half + " " + end_time(c, 2 * c.n), half + ".restart.log"), 0)
+      << slurp(half + ".restart.log");
+  expect_same_checkpoint(full, half);
+  expect_same_checkpoint(full, other);
+  expect_same_diagnostics(full, half);
+  expect_same_diagnostics(full, other, c.n + 1);
+  // The new directory starts at the checkpoint: its frame 0 is step n.
+  EXPECT_EQ(bfemp::read_attribute(other + "/bfemp.h5", "/frame_000000", "step"), c.n);
+  return mid;
+}
+
+const std::string squash = src + "/tests/data/squash_10_steps.yaml";
+const std::string disk_wall = src + "/inputs/contact_disk_wall.yaml";
+const std::string friction_sets =
+    "--set 'Contact/friction=0.3' --set 'MPM Bodies/disk/initial velocity={100.0, 30.0}' "
+    "--set 'Output/frame every=3' --set 'Output/progress every=0'";
+
+// A 0.2 m block thrown at 6 m/s out of a 0.5 m grid that extends.
+std::string thrown_scene() {
+  const std::string path = root + "/thrown.yaml";
+  fs::create_directories(root);
+  std::ofstream(path) << R"(bfemp:
+  dimension: 2
+  gravity: [0.0, -9.81]
+  Time:
+    dt: 1.0e-2
+    end time: 0.1
+    integrator: newmark
+  Output:
+    frame every: 4
+    progress every: 0
+  Materials:
+    jelly:
+      E: 1.0e5
+      nu: 0.3
+      density: 1000.0
+  MPM:
+    grid spacing: 0.05
+    domain min: [0.0, 0.0]
+    domain max: [0.5, 0.5]
+    particles per cell: 4
+    transfer: APIC
+    when particles leave: extend
+  MPM Bodies:
+    block:
+      material: jelly
+      shape: box
+      center: [0.25, 0.25]
+      size: [0.2, 0.2]
+      initial velocity: [6.0, 2.0]
+)";
+  return path;
+}
+
+pid_t spawn(const std::vector<std::string>& args, const std::string& log) {
+  std::vector<std::string> env_s = {"OMP_NUM_THREADS=1", "OMP_PROC_BIND=false", "OPENBLAS_NUM_THREADS=1"};
+  // The parent's environment but for those three, as std::system passes it
+  // (OPENBLAS_CORETYPE and the like choose BLAS kernels: other round-off).
+  for (char** e = environ; *e; ++e)
+    if (std::strncmp(*e, "OMP_NUM_THREADS=", 16) && std::strncmp(*e, "OMP_PROC_BIND=", 14) &&
+        std::strncmp(*e, "OPENBLAS_NUM_THREADS=", 21))
+      env_s.push_back(*e);
+  std::vector<char*> argv, envp;
+  for (const auto& a : args) argv.push_back(const_cast<char*>(a.c_str()));
+  argv.push_back(nullptr);
+  for (const auto& e : env_s) envp.push_back(const_cast<char*>(e.c_str()));
+  envp.push_back(nullptr);
+  posix_spawn_file_actions_t fa;
+  posix_spawn_file_actions_init(&fa);
+  posix_spawn_file_actions_addopen(&fa, 1, log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  posix_spawn_file_actions_adddup2(&fa, 1, 2);
+  pid_t pid = -1;
+  EXPECT_EQ(posix_spawn(&pid, exe.c_str(), &fa, nullptr, argv.data(), envp.data()), 0);
+  posix_spawn_file_actions_destroy(&fa);
+  return pid;
+}
+
+// Waits until diagnostics.csv in `dir` has `rows` data rows (false after
+// 120 s or when the child exits first).
+bool wait_rows(pid_t pid, const std::string& dir, std::size_t rows) {
+  const auto t0 = std::chrono::steady_clock::now();
+  while (std::chrono::steady_clock::now() - t0 < std::chrono::seconds(120)) {
+    if (fs::exists(dir + "/diagnostics.csv") && csv(dir + "/diagnostics.csv").size() > rows) return true;
+    if (kill(pid, 0) != 0) return false;
+    int st = 0;
+    if (waitpid(pid, &st, WNOHANG) == pid) {
+      ADD_FAILURE() << "the run ended before the signal: " << slurp(dir + ".log");
+      return false;
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  return false;
+}
+
+int wait_exit(pid_t pid) {
+  int st = 0;
+  waitpid(pid, &st, 0);
+  return WIFEXITED(st) ? WEXITSTATUS(st) : (WIFSIGNALED(st) ? 1000 + WTERMSIG(st) : -1);
+}
+
+// Signals a run of the friction contact scene after `rows` steps.
+long interrupt_and_restart(int sig, int expected_exit) {
+  const Case c{"sig" + std::to_string(sig), disk_wall, friction_sets, 1e-3, 0};
+  const std::string dir = fresh(c.tag);
+  const pid_t pid = spawn({exe, "run", disk_wall, "--set", "Contact/friction=0.3", "--set",
+                           "MPM Bodies/disk/initial velocity={100.0, 30.0}", "--set", "Output/frame every=3",
+                           "--set", "Time/end time=1.0", "-o", dir},
+                          dir + ".log");
+  EXPECT_TRUE(wait_rows(pid, dir, 4));
+  kill(pid, sig);
+  EXPECT_EQ(wait_exit(pid), expected_exit) << slurp(dir + ".log");
+  const std::string log = slurp(dir + ".log");
+  EXPECT_NE(log.find("continue with: bfemp restart " + dir), std::string::npos) << log;
+  const bfemp::Checkpoint ck = bfemp::read_checkpoint(dir + "/checkpoint.h5");
+  EXPECT_GE(ck.step, 4);
+  // The last frame is the interrupted step's state.
+  const int last = ck.frames - 1;
+  char name[32];
+  std::snprintf(name, sizeof name, "/frame_%06d", last);
+  EXPECT_EQ(bfemp::read_attribute(dir + "/bfemp.h5", name, "step"), ck.step);
+  const std::string ref = fresh(c.tag + "_ref");
+  const std::string end = end_time(c, ck.step + 4);
+  EXPECT_EQ(run_bfemp("run " + disk_wall + " " + friction_sets + " " + end + " -o " + ref, ref + ".log"), 0)
+      << slurp(ref + ".log");
+  EXPECT_EQ(run_bfemp("restart " + dir + " " + end, dir + ".restart.log"), 0) << slurp(dir + ".restart.log");
+  expect_same_checkpoint(ref, dir);
+  return ck.step;
+}
+
+}  // namespace
+
+TEST(Restart, FemSceneContinuesBitForBit) {
+  restart_equals_uninterrupted({"fem", squash, "--set 'Output/frame every=3'", 1e-2, 5});
+  // Newmark carries the acceleration a^n across the restart.
+  restart_equals_uninterrupted(
+      {"fem_nm", squash, "--set 'Output/frame every=3' --set 'Time/integrator=newmark'", 1e-2, 5});
+}
+
+TEST(Restart, MpmSceneWithExtendContinuesBitForBit) {
+  const Case c{"mpm_extend", thrown_scene(), "", 1e-2, 6};
+  const bfemp::Checkpoint mid = restart_equals_uninterrupted(c);
+  // The grid grew before the restart and again after it.
+  const auto end = bfemp::read_checkpoint(dir_of("mpm_extend_other") + "/checkpoint.h5");
+  EXPECT_GE(mid.ints("grid_extensions")[0], 1);
+  EXPECT_GT(end.ints("grid_extensions")[0], mid.ints("grid_extensions")[0])
+      << "the grid should extend after the restart too";
+}
+
+TEST(Restart, FrictionContactBackwardEulerBitForBit) {
+  restart_equals_uninterrupted({"contact_be", disk_wall, friction_sets, 1e-3, 6});
+  const auto rows = csv(dir_of("contact_be_full") + "/diagnostics.csv");
+  int friction_iters_max = 0;
+  long pairs = 0;
+  for (std::size_t i = 1; i < rows.size(); ++i) {
+    friction_iters_max = std::max(friction_iters_max, std::stoi(rows[i][20]));
+    pairs = std::max(pairs, std::stol(rows[i][17]));
+  }
+  EXPECT_GT(pairs, 0) << "the scene must be in contact";
+  EXPECT_GE(friction_iters_max, 2) << "the friction loop must be active";
+}
+
+TEST(Restart, FrictionContactNewmarkBitForBit) {
+  restart_equals_uninterrupted(
+      {"contact_nm", disk_wall, friction_sets + " --set 'Time/integrator=newmark' --set 'MPM/when particles leave=extend'",
+       1e-3, 6});
+}
+
+TEST(Restart, SigtermWritesACheckpointAndExits143) { interrupt_and_restart(SIGTERM, 143); }
+
+TEST(Restart, SigintWritesACheckpointAndExits130) { interrupt_and_restart(SIGINT, 130); }
+
+TEST(Restart, SigkillLeavesReadableFramesAndRestartsFromTheLastCheckpoint) {
+  const std::string dir = fresh("sigkill");
+  const pid_t pid = spawn({exe, "run", disk_wall, "--set", "Contact/friction=0.3", "--set",
+                           "MPM Bodies/disk/initial velocity={100.0, 30.0}", "--set", "Output/frame every=1",
+                           "--set", "Output/checkpoint every=4", "--set", "Time/end time=1.0", "-o", dir},
+                          dir + ".log");
+  ASSERT_TRUE(wait_rows(pid, dir, 10));
+  kill(pid, SIGKILL);
+  EXPECT_EQ(wait_exit(pid), 1000 + SIGKILL);
+  // Every dataset the XDMF references exists with the stated dimensions.
+  const std::string xdmf = slurp(dir + "/bfemp.xdmf");
+  const std::regex item(R"re(<DataItem[^>]*Dimensions="([0-9 ]+)"[^>]*>\s*bfemp\.h5:([^<\s]+)\s*</DataItem>)re");
+  int items = 0;
+  for (auto it = std::sregex_iterator(xdmf.begin(), xdmf.end(), item); it != std::sregex_iterator(); ++it) {
+    std::istringstream dims((*it)[1].str());
+    std::size_t n = 1;
+    for (std::size_t d; dims >> d;) n *= d;
+    const auto v = bfemp::read_dataset(dir + "/bfemp.h5", (*it)[2].str(), nullptr);
+    EXPECT_EQ(v.size(), n) << (*it)[2].str();
+    ++items;
+  }
+  EXPECT_GT(items, 20) << xdmf;
+  const bfemp::Checkpoint ck = bfemp::read_checkpoint(dir + "/checkpoint.h5");
+  EXPECT_EQ(ck.step % 4, 0);
+  EXPECT_GE(ck.step, 4);
+  const Case c{"sigkill", disk_wall, friction_sets + " --set 'Output/frame every=1'", 1e-3, 0};
+  const std::string ref = fresh("sigkill_ref");
+  const std::string end = end_time(c, ck.step + 3);
+  ASSERT_EQ(run_bfemp("run " + disk_wall + " " + c.sets + " " + end + " -o " + ref, ref + ".log"), 0)
+      << slurp(ref + ".log");
+  ASSERT_EQ(run_bfemp("restart " + dir + " " + end, dir + ".restart.log"), 0) << slurp(dir + ".restart.log");
+  expect_same_checkpoint(ref, dir);
+  expect_same_diagnostics(ref, dir);  // rows after the checkpoint were dropped, then rewritten
+  // frames: one per step, 0 .. step, no duplicate left from before the kill
+  EXPECT_EQ(bfemp::read_checkpoint(dir + "/checkpoint.h5").frames, ck.step + 3 + 1);
+}
+
+TEST(Restart, SetOfAShapeChangingKeyIsRefused) {
+  const Case c{"refuse", squash, "", 1e-2, 2};
+  const std::string dir = fresh("refuse");
+  ASSERT_EQ(run_bfemp("run " + squash + " " + end_time(c, 2) + " -o " + dir, dir + ".log"), 0);
+  EXPECT_EQ(run_bfemp("restart " + dir + " --set 'Materials/soft/E=2e5'", dir + ".r.log"), 2);
+  EXPECT_NE(slurp(dir + ".r.log").find("'Materials/soft/E'"), std::string::npos) << slurp(dir + ".r.log");
+  EXPECT_EQ(run_bfemp("restart " + root + "/no_such_run", dir + ".r2.log"), 2);
+  EXPECT_NE(slurp(dir + ".r2.log").find("checkpoint.h5"), std::string::npos) << slurp(dir + ".r2.log");
+  EXPECT_EQ(run_bfemp("restart " + dir + " " + end_time(c, 4) + " --set 'Linear Solver/type=KLU2'", dir + ".r3.log"), 0)
+      << slurp(dir + ".r3.log");
+}
