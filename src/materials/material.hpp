@@ -5,6 +5,7 @@
 #include "materials/lame.hpp"
 #include "materials/linear_elastic.hpp"
 #include "materials/neo_hookean.hpp"
+#include "materials/neo_hookean_psd.hpp"
 #include "materials/psd_projection.hpp"
 
 namespace bfemp {
@@ -53,9 +54,12 @@ KOKKOS_INLINE_FUNCTION StressDerivative<dim> material_stress_derivative(const Ma
 // dP/dF projected onto the PSD cone (for a convex Newton model). The linear
 // elastic tangent has eigenvalues 2 mu, 0 and 2 mu + dim lambda; it is
 // returned as is when those are >= 0 (the projection would not change it).
+// Neo-Hookean: the analytic projection from the singular values of F
+// (materials/neo_hookean_psd.hpp); otherwise the eigensolver.
 template <int dim>
 KOKKOS_INLINE_FUNCTION StressDerivative<dim> material_stress_derivative_psd(const MaterialParams& m,
                                                                             const Mat<dim>& F) {
+  if (m.model == MaterialModel::NeoHookean) return neo_hookean_stress_derivative_psd<dim>(F, m.lame);
   StressDerivative<dim> dPdF = material_stress_derivative<dim>(m, F);
   const bool known_psd = m.model == MaterialModel::LinearElastic && m.lame.mu >= 0.0 &&
                          2.0 * m.lame.mu + dim * m.lame.lambda >= 0.0;

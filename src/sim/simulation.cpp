@@ -147,6 +147,31 @@ void Simulation<dim>::prescribed_velocities(double t1) {
   Kokkos::deep_copy(a_, ah);
 }
 
+// Grid nodes that a particle's stencil reaches with weight 0 (a particle at a
+// cell centre is 1.5 dx from the far nodes, where the quadratic B-spline and
+// its gradient vanish: 9 particles per cell in 2D, 27 in 3D) carry no mass
+// and no stiffness, so the Newton matrix would be singular there. They take
+// no part in any transfer; hold them in place (prescribed, v = 0, mass 0).
+// "No mass": below 1e-12 of the heaviest node (round-off of a zero weight).
+namespace {
+void hold_massless_grid_nodes(std::size_t first, std::size_t n, View1 x, View1 v, View1 mass, View1 target,
+                              Kokkos::View<int*, MemSpace> pres) {
+  double mmax = 0;
+  Kokkos::parallel_reduce(
+      "grid_mass_max", Kokkos::RangePolicy<ExecSpace>(first, n),
+      KOKKOS_LAMBDA(const std::size_t i, double& m) { m = mass(i) > m ? mass(i) : m; }, Kokkos::Max<double>(mmax));
+  const double floor = 1e-12 * mmax;
+  Kokkos::parallel_for(
+      "grid_hold_massless", Kokkos::RangePolicy<ExecSpace>(first, n), KOKKOS_LAMBDA(const std::size_t i) {
+        if (mass(i) > floor) return;
+        pres(i) = 1;
+        mass(i) = 0.0;
+        v(i) = 0.0;
+        target(i) = x(i);
+      });
+}
+}  // namespace
+
 template <int dim>
 StepReport Simulation<dim>::step() {
   Kokkos::Timer timer;
@@ -182,6 +207,7 @@ StepReport Simulation<dim>::step() {
     auto grid_part = std::make_pair(nfd, nd);
     Kokkos::deep_copy(Kokkos::subview(pres, grid_part), 0);
     mpm_->fill_system(x, v, mass);
+    hold_massless_grid_nodes(nfd, nd, x, v, mass, target, pres);
     apply_level_sets<dim>(level_sets_, time_, dt, nfd, nd, x, v, target, pres);
     newton_->slip_constraints().build(level_sets_, time_, dt, nfd, nd, x, v, pres);  // slip: n . v = n . v_b
     terms.push_back(&mpm_->term());
@@ -198,7 +224,7 @@ StepReport Simulation<dim>::step() {
     const std::size_t off = nfd;
     Kokkos::parallel_for(
         "grid_a0", Kokkos::RangePolicy<ExecSpace>(off, nd),
-        KOKKOS_LAMBDA(const std::size_t i) { a(i) = work(i) / mass(i) + g[i % dim]; });
+        KOKKOS_LAMBDA(const std::size_t i) { a(i) = mass(i) > 0 ? work(i) / mass(i) + g[i % dim] : 0.0; });
     Kokkos::deep_copy(v_old, v);
   }
   Kokkos::parallel_for(
