@@ -1,15 +1,19 @@
 #!/usr/bin/env bash
 # bfemp set-up: Debian packages + Trilinos 13.2 with Kokkos' OpenMP backend.
 # Idempotent; run as root on Debian bookworm.
-#   scripts/setup.sh [--prefix DIR] [--archive FILE] [--from-source] [--no-apt]
+#   scripts/setup.sh [--prefix DIR] [--archive FILE] [--from-source] [--no-apt] [--with-paraview]
 # The prebuilt archive (shared/deps/README.md) is used when --archive or
 # BFEMP_TRILINOS_ARCHIVE names it, or when ../shared/deps holds it.
+# --with-paraview also installs ParaView 5.11 with pvpython (paraview,
+# python3-paraview) and xvfb, xauth for `ctest -L paraview`; not by default
+# (about 150 MB to download, 800 MB installed).
 set -euo pipefail
 
 PREFIX_ROOT=${BFEMP_DEPS_PREFIX:-/opt/bfemp-deps}
 ARCHIVE=${BFEMP_TRILINOS_ARCHIVE:-}
 FROM_SOURCE=0
 DO_APT=1
+WITH_PARAVIEW=0
 here=$(cd "$(dirname "$0")/.." && pwd)
 
 while [ $# -gt 0 ]; do
@@ -18,8 +22,9 @@ while [ $# -gt 0 ]; do
     --archive) ARCHIVE=$2; shift 2;;
     --from-source) FROM_SOURCE=1; shift;;
     --no-apt) DO_APT=0; shift;;
-    -h|--help) sed -n 2,8p "$0"; exit 0;;
-    *) echo "setup.sh: unknown option '$1' (expected --prefix, --archive, --from-source, --no-apt)" >&2; exit 2;;
+    --with-paraview) WITH_PARAVIEW=1; shift;;
+    -h|--help) sed -n 2,9p "$0"; exit 0;;
+    *) echo "setup.sh: unknown option '$1' (expected --prefix, --archive, --from-source, --no-apt, --with-paraview)" >&2; exit 2;;
   esac
 done
 
@@ -33,6 +38,11 @@ PACKAGES="build-essential cmake ninja-build dpkg-dev xz-utils pkg-config
   libopenmpi-dev openmpi-bin libhdf5-openmpi-dev libopenblas-dev liblapack-dev
   libsuitesparse-dev libeigen3-dev libgtest-dev libbenchmark-dev libcli11-dev
   libgmsh-dev python3-matplotlib python3-h5py"
+# pvpython is in python3-paraview (only a Recommends of paraview).
+if [ $WITH_PARAVIEW -eq 1 ]; then
+  [ $DO_APT -eq 1 ] || { echo "setup.sh: --with-paraview installs Debian packages; it cannot go with --no-apt" >&2; exit 2; }
+  PACKAGES="$PACKAGES paraview python3-paraview xvfb xauth"
+fi
 
 if [ $DO_APT -eq 1 ]; then
   missing=$(dpkg-query -W -f='${Package} ${Status}\n' $PACKAGES 2>/dev/null | grep -v "install ok installed" | cut -d' ' -f1 || true)
