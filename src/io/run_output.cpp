@@ -59,6 +59,13 @@ RunOutput<dim>::RunOutput(const std::string& dir, const Scene& scene, const Simu
   for (std::size_t e = 0; e < cells.extent(0); ++e)
     for (int a = 0; a <= dim; ++a) conn[e * (dim + 1) + a] = cells(e, a);
   if (!conn.empty() && !resume) h5_->write_static("cells", conn.data(), cells.extent(0), dim + 1);
+  // Explicit polyvertex connectivity 0 .. np-1: without it ParaView's Xdmf3
+  // readers give the particle grid points but no cells (nothing is drawn).
+  if (const auto* mpm = sim.mpm(); mpm && !resume) {
+    std::vector<long long> ids(mpm->particles().size());
+    for (std::size_t q = 0; q < ids.size(); ++q) ids[q] = static_cast<long long>(q);
+    h5_->write_static("particle_vertices", ids.data(), ids.size(), 1);
+  }
 }
 
 template <int dim>
@@ -82,7 +89,7 @@ XdmfFrame RunOutput<dim>::xdmf_frame(const Simulation<dim>& sim, int index, doub
     XdmfGrid g;
     g.name = "particles";
     g.group = Hdf5FrameWriter::frame_group_name(index);
-    g.topology = {"Polyvertex", np, 1, ""};
+    g.topology = {"Polyvertex", np, 1, "/mesh/particle_vertices"};
     g.num_nodes = np;
     g.dim = dim;
     g.geometry = "particle_positions";

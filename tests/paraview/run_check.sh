@@ -11,7 +11,7 @@
 #   - no pvpython (PVPYTHON or on PATH): nothing is checked;
 #   - no xvfb-run and no DISPLAY: the arrays are checked (a wrong one fails)
 #     but no screenshot can be rendered, so the test reports skipped.
-# BFEMP_PARAVIEW_STRICT=1 also fails on the known issue check_xdmf.py reports.
+# Always strict: the particle grid must have one cell per particle.
 set -uo pipefail
 if [ $# -ne 3 ]; then
   sed -n 2,3p "$0" >&2
@@ -51,8 +51,7 @@ fi
 tail -n 3 "$work/bfemp_run.log"
 
 check=$src/tests/paraview/check_xdmf.py
-strict=()
-[ "${BFEMP_PARAVIEW_STRICT:-0}" = 1 ] && strict=(--strict)
+strict=(--strict)  # the particle grid's cells (fixed in the writer) are checked too
 png=$work/paraview_check.png
 if [ -n "$xvfb_run" ]; then
   echo "== pvpython under xvfb-run: $check"
