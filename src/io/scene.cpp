@@ -381,6 +381,7 @@ SimulationSetup<dim> build_setup(const Scene& scene) {
     setup.bodies.push_back(std::move(in));
   }
   build_mpm<dim>(scene, mat_names, setup);
+  check_friction_pairs(p);
   if (setup.mpm && !setup.bodies.empty() && p.sublist("Contact").get<bool>("enabled")) setup.contact = contact_from(p);
   const auto& time = p.sublist("Time");
   setup.dt = time.get<double>("dt");

@@ -114,10 +114,17 @@ void check_contact(const ParameterList& raw) {
   for (const char* k : {"dhat", "kappa", "eps_v"}) positive(c, "Contact/", k, "a positive value");
   if (!(c.get<double>("friction") >= 0)) bad("Contact/friction", num(c.get<double>("friction")), "mu >= 0");
   at_least(c, "Contact/", "friction iterations", 1);
+  const std::string fb = c.get<std::string>("force body");
+  if (!fb.empty() && !raw.sublist("FEM Bodies").isSublist(fb))
+    bad("Contact/force body", "'" + fb + "'", "the name of an FEM body");
+}
+
+}  // namespace
+
+void check_friction_pairs(const ParameterList& raw) {
+  const auto& c = raw.sublist("Contact");
   const auto& fem = raw.sublist("FEM Bodies");
   const auto& mpm = raw.sublist("MPM Bodies");
-  const std::string fb = c.get<std::string>("force body");
-  if (!fb.empty() && !fem.isSublist(fb)) bad("Contact/force body", "'" + fb + "'", "the name of an FEM body");
   const auto& pairs = c.sublist("Friction Pairs");
   for (auto it = pairs.begin(); it != pairs.end(); ++it) {
     const std::string name = pairs.name(it), key = "Contact/Friction Pairs/" + name;
@@ -133,8 +140,6 @@ void check_contact(const ParameterList& raw) {
     if (!(mu >= 0) || !std::isfinite(mu)) bad(key, num(mu), "a finite mu >= 0");
   }
 }
-
-}  // namespace
 
 void check_scene_values(const ParameterList& raw) {
   const int dim = raw.get<int>("dimension");

@@ -19,6 +19,11 @@ namespace bfemp {
 // (types right, defaults filled).
 void check_scene_values(const Teuchos::ParameterList& scene);
 
+// The keys of 'Contact/Friction Pairs' ('<MPM body> : <FEM body>' naming
+// bodies of the scene) and their mu (a finite number >= 0), whether or not
+// contact is enabled; checked when the set-up is built.
+void check_friction_pairs(const Teuchos::ParameterList& scene);
+
 // At most this many steps (end time / dt) are run; more is refused.
 constexpr double kMaxSteps = 1e9;
 
