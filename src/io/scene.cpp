@@ -58,8 +58,8 @@ Scene finish(ParameterList raw, const std::string& path, const std::string& base
              const std::vector<std::string>& overrides) {
   auto schema = scene_schema();
   if (raw.name() != "bfemp")
-    throw std::invalid_argument("scene '" + path + "': top-level key '" + raw.name() +
-                                "', expected 'bfemp'");
+    throw std::invalid_argument((path.empty() ? std::string("scene") : "scene file '" + path + "'") +
+                                ": top-level key '" + raw.name() + "', expected 'bfemp'");
   for (const auto& o : overrides) apply_scene_override(raw, *schema, o);
   if (raw.isSublist("Materials")) {  // an empty entry would run silently on every default
     const auto& mats = raw.sublist("Materials");

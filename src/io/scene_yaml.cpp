@@ -3,6 +3,7 @@
 #include "io/scene_yaml.hpp"
 
 #include <Teuchos_YamlParameterListHelpers.hpp>
+#include <algorithm>
 #include <map>
 #include <regex>
 #include <stdexcept>
@@ -19,6 +20,16 @@ std::string trim(const std::string& s) {
   while (a < b && is_space(s[a])) ++a;
   while (b > a && is_space(s[b - 1])) --b;
   return s.substr(a, b - a);
+}
+
+std::vector<std::string> split_lines(const std::string& text) {
+  std::vector<std::string> lines;
+  for (std::size_t a = 0; a <= text.size();) {
+    const std::size_t b = std::min(text.find('\n', a), text.size());
+    lines.push_back(text.substr(a, b - a));
+    a = b + 1;
+  }
+  return lines;
 }
 
 std::string join(const std::string& path, const std::string& key) {
@@ -206,12 +217,7 @@ bool block_key(const std::string& c, std::string& key, std::string& value) {
 // (with that line of the scene), and the text without source paths, throw
 // counters, parser states and lexer dumps.
 std::string parser_message(const std::string& what, const std::string& yaml) {
-  std::vector<std::string> in;
-  for (std::size_t a = 0; a <= what.size();) {
-    const std::size_t b = std::min(what.find('\n', a), what.size());
-    in.push_back(what.substr(a, b - a));
-    a = b + 1;
-  }
+  const std::vector<std::string> in = split_lines(what);
   static const std::regex at("line ([0-9]+) column ([0-9]+)");
   static const std::regex source_path("^.*\\.(cpp|hpp|h):[0-9]+:\\s*$");
   static const std::regex exists("Parameter \"(.*)\" already exists in list .*");
@@ -221,14 +227,11 @@ std::string parser_message(const std::string& what, const std::string& yaml) {
     const std::string t = trim(in[i]);
     std::smatch m;
     if (t.rfind("error: ", 0) == 0 && std::regex_search(t, m, at)) {
-      const int line = std::stoi(m[1]);
+      const std::size_t line = std::stoul(m[1]);
       where = " line " + std::string(m[1]) + ", column " + std::string(m[2]);
-      std::size_t a = 0;  // quote that line of the scene
-      for (int l = 1; l < line && a != std::string::npos; ++l) a = yaml.find('\n', a) == std::string::npos ? std::string::npos : yaml.find('\n', a) + 1;
-      if (a != std::string::npos && a < yaml.size()) {
-        const std::string src = trim(yaml.substr(a, yaml.find('\n', a) - a));
-        if (!src.empty()) where += " ('" + src + "')";
-      }
+      const std::vector<std::string> src = split_lines(yaml);  // quote that line of the scene
+      if (line >= 1 && line <= src.size() && !trim(src[line - 1]).empty())
+        where += " ('" + trim(src[line - 1]) + "')";
       continue;
     }
     if (t.empty() || t == "^" || std::regex_match(t, source_path) || t.rfind("Throw number", 0) == 0 ||
@@ -236,10 +239,11 @@ std::string parser_message(const std::string& what, const std::string& yaml) {
       continue;
     if (i + 1 < in.size() && trim(in[i + 1]) == "^") continue;  // the quoted line above the caret
     if (t.rfind("Lexer text:", 0) == 0) {
-      // The lexer's text is quoted and may span lines ("\n").
-      if (t.size() < 14 || t.back() != '"')
-        while (i + 1 < in.size() && (trim(in[i + 1]).empty() || trim(in[i + 1]).back() != '"')) ++i;
-      if (t.size() < 14 || t.back() != '"') ++i;
+      // The lexer's text is quoted and may span lines (a newline): skip to
+      // the closing quote.
+      if (std::count(t.begin(), t.end(), '"') % 2 == 1)
+        while (i + 1 < in.size() && in[++i].find('"') == std::string::npos) {
+        }
       continue;
     }
     if (std::regex_match(t, m, exists)) {
@@ -261,11 +265,9 @@ std::string parser_message(const std::string& what, const std::string& yaml) {
 
 // False when every line is blank, a comment, a directive or a document marker.
 bool has_content(const std::string& yaml) {
-  for (std::size_t a = 0; a < yaml.size();) {
-    const std::size_t b = std::min(yaml.find('\n', a), yaml.size());
-    const std::string t = trim(yaml.substr(a, b - a));
+  for (const auto& l : split_lines(yaml)) {
+    const std::string t = trim(l);
     if (!t.empty() && t[0] != '#' && t[0] != '%' && t != "---" && t != "...") return true;
-    a = b + 1;
   }
   return false;
 }
@@ -274,12 +276,7 @@ bool has_content(const std::string& yaml) {
 
 void check_duplicate_keys(const std::string& yaml, const std::string& label) {
   const Reporter rep{label};
-  std::vector<std::string> lines;
-  for (std::size_t a = 0; a <= yaml.size();) {
-    const std::size_t b = std::min(yaml.find('\n', a), yaml.size());
-    lines.push_back(yaml.substr(a, b - a));
-    a = b + 1;
-  }
+  const std::vector<std::string> lines = split_lines(yaml);
   struct Level {
     int indent;
     std::string path;

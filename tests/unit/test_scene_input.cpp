@@ -138,6 +138,17 @@ TEST(SceneInput, SetStringsAndFreeFormLists) {
                  {"Contact/Friction Pairs/left : floor", "naming bodies"});
 }
 
+TEST(SceneInput, SetIntoFreeFormSolverLists) {
+  const Scene s = load(kScene, {"Linear Solver/CG/Ifpack2/relaxation: sweeps=2"});
+  const auto& ifp = s.params.sublist("Linear Solver").sublist("CG").sublist("Ifpack2");
+  EXPECT_EQ(ifp.get<int>("relaxation: sweeps"), 2);
+  EXPECT_EQ(ifp.get<std::string>("relaxation: type"), "Symmetric Gauss-Seidel");
+}
+
+TEST(SceneInput, TopLevelKeyIsNamed) {
+  expect_message(error_of("simulation:\n  dimension: 2\n"), {"scene: top-level key 'simulation'", "'bfemp'"});
+}
+
 TEST(SceneInput, DuplicateBlockKeyNamesPathAndLines) {
   const std::string yaml = replaced(kScene, "    kappa: 1.0e5\n", "    kappa: 1.0e5\n    dhat: 1.0e-3\n    kappa: 2.0e5\n");
   // kScene's 'kappa' is on line 25.
