@@ -197,7 +197,10 @@ void apply_scene_override(ParameterList& list, const ParameterList& schema, cons
         l->setEntry(part, parse_yaml_value(value, what));
         return;
       }
-      if (!s->isParameter(part) || s->isSublist(part))
+      if (s->isSublist(part))
+        throw std::invalid_argument(what + ": '" + part + "' is a sublist; set one of its keys, '" + path +
+                                    "/<key>=value'");
+      if (!s->isParameter(part))
         throw std::invalid_argument(what + ": unknown key '" + part + "'; expected one of " + valid_names(*s));
       const auto& want = s->getEntry(part);
       if (want.isType<std::string>()) {  // text as written; quotes optional

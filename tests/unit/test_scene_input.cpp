@@ -145,6 +145,13 @@ TEST(SceneInput, SetIntoFreeFormSolverLists) {
   EXPECT_EQ(ifp.get<std::string>("relaxation: type"), "Symmetric Gauss-Seidel");
 }
 
+TEST(SceneInput, SetOfASublistOrUnknownKeyIsNamed) {
+  expect_message(error_of(kScene, {"Time=5"}), {"--set 'Time'", "is a sublist", "Time/<key>=value"});
+  expect_message(error_of(kScene, {"Time/dtt=5"}), {"--set 'Time/dtt'", "unknown key 'dtt'", "'dt'"});
+  expect_message(error_of(kScene, {"MPM Bodies/ghost/center=[0.0, 0.0]"}), {"no entry 'ghost'", "MPM Bodies"});
+  expect_message(error_of(kScene, {"Time/dt"}), {"--set 'Time/dt'", "path/to/key=value"});
+}
+
 TEST(SceneInput, TopLevelKeyIsNamed) {
   expect_message(error_of("simulation:\n  dimension: 2\n"), {"scene: top-level key 'simulation'", "'bfemp'"});
 }
