@@ -1,13 +1,16 @@
 #include "io/scene.hpp"
 
 #include <Teuchos_Array.hpp>
-#include <Teuchos_YamlParameterListHelpers.hpp>
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
+#include <regex>
 #include <sstream>
 
 #include "io/gmsh_reader.hpp"
+#include "io/scene_checks.hpp"
 #include "io/scene_validate.hpp"
+#include "io/scene_yaml.hpp"
 #include "io/shape_mesher.hpp"
 #include "mpm/sampling.hpp"
 
@@ -28,74 +31,48 @@ std::string num(double v) {
   return s.str();
 }
 
+std::string list(const Array<double>& a) {
+  std::string s = "[";
+  for (Array<double>::size_type i = 0; i < a.size(); ++i) s += (i ? ", " : "") + num(a[i]);
+  return s + "]";
+}
+
+// Rethrows a sampling or meshing error ("sampling field 'outer_radius' = 0:
+// expected ...") under the scene key it came from ("scene key 'MPM
+// Bodies/disk/outer radius' = 0: expected ... (shape 'disk')").
+[[noreturn]] void rethrow_under(const std::string& key, const std::string& shape, const std::invalid_argument& e) {
+  static const std::regex field("^(sampling|shape) field '([a-z_]+)(\\[[0-9]+\\])?' = (.*)$");
+  const std::string what = e.what();
+  std::smatch m;
+  if (!std::regex_match(what, m, field)) throw std::invalid_argument("scene key '" + key + "': " + what);
+  std::string f = m[2];
+  if (f == "dx") f = "(MPM/grid spacing)";
+  else if (f == "kind") f = "shape";
+  else std::replace(f.begin(), f.end(), '_', ' ');
+  const std::string k = f[0] == '(' ? "MPM/grid spacing" : key + "/" + f;
+  throw std::invalid_argument("scene key '" + k + std::string(m[3]) + "' = " + std::string(m[4]) +
+                              " (shape '" + shape + "')");
+}
+
 Scene finish(ParameterList raw, const std::string& path, const std::string& base_dir,
              const std::vector<std::string>& overrides) {
   auto schema = scene_schema();
   if (raw.name() != "bfemp")
-    throw std::invalid_argument("scene '" + path + "': top-level key '" + raw.name() +
-                                "', expected 'bfemp'");
+    throw std::invalid_argument((path.empty() ? std::string("scene") : "scene file '" + path + "'") +
+                                ": top-level key '" + raw.name() + "', expected 'bfemp'");
   for (const auto& o : overrides) apply_scene_override(raw, *schema, o);
+  if (raw.isSublist("Materials")) {  // an empty entry would run silently on every default
+    const auto& mats = raw.sublist("Materials");
+    for (auto it = mats.begin(); it != mats.end(); ++it)
+      if (mats.entry(it).isList() && mats.sublist(mats.name(it)).numParams() == 0)
+        bad("Materials/" + mats.name(it), "(nothing)", "a material with its keys (model, E, nu, density)");
+  }
   validate_scene_list(raw, *schema, "");
+  check_scene_values(raw);
   Scene s;
   s.path = path;
   s.base_dir = base_dir;
   s.params = raw;
-  const int dim = s.dim();
-  if (dim != 2 && dim != 3) bad("dimension", std::to_string(dim), "2 or 3");
-  const auto& time = raw.sublist("Time");
-  if (!(time.get<double>("dt") > 0)) bad("Time/dt", num(time.get<double>("dt")), "dt > 0 (s)");
-  if (!(time.get<double>("end time") > 0))
-    bad("Time/end time", num(time.get<double>("end time")), "a positive time (s)");
-  if (!(raw.sublist("Newton").get<double>("eps_d") > 0))
-    bad("Newton/eps_d", num(raw.sublist("Newton").get<double>("eps_d")), "eps_d > 0 (m/s)");
-  if (raw.sublist("Newton").get<int>("max iterations") < 1)
-    bad("Newton/max iterations", std::to_string(raw.sublist("Newton").get<int>("max iterations")), ">= 1");
-  if (raw.sublist("Output").get<int>("frame every") < 1)
-    bad("Output/frame every", std::to_string(raw.sublist("Output").get<int>("frame every")), ">= 1");
-  const auto g = raw.get<Array<double>>("gravity");
-  if (!g.empty() && static_cast<int>(g.size()) != dim)
-    bad("gravity", Teuchos::toString(g), std::to_string(dim) + " components");
-  const auto& mats = raw.sublist("Materials");
-  for (auto it = mats.begin(); it != mats.end(); ++it) {
-    const auto& m = mats.sublist(mats.name(it));
-    const std::string k = "Materials/" + mats.name(it) + "/";
-    if (!(m.get<double>("E") > 0)) bad(k + "E", num(m.get<double>("E")), "E > 0 (Pa)");
-    const double nu = m.get<double>("nu");
-    if (!(nu > -1 && nu < 0.5)) bad(k + "nu", num(nu), "a Poisson ratio in (-1, 0.5)");
-    if (!(m.get<double>("density") > 0)) bad(k + "density", num(m.get<double>("density")), "density > 0");
-  }
-  const auto& mpm_bodies = raw.sublist("MPM Bodies");
-  if (raw.sublist("FEM Bodies").numParams() + mpm_bodies.numParams() == 0)
-    bad("FEM Bodies", "{}", "at least one FEM or MPM body");
-  for (const char* container : {"FEM Bodies", "MPM Bodies"}) {
-    const auto& bodies = raw.sublist(container);
-    for (auto it = bodies.begin(); it != bodies.end(); ++it) {
-      const std::string mname = bodies.sublist(bodies.name(it)).get<std::string>("material");
-      if (!mats.isSublist(mname))
-        bad(std::string(container) + "/" + bodies.name(it) + "/material", "'" + mname + "'",
-            "the name of an entry of Materials");
-    }
-  }
-  if (mpm_bodies.numParams() > 0) {
-    const auto& m = raw.sublist("MPM");
-    if (!(m.get<double>("grid spacing") > 0)) bad("MPM/grid spacing", num(m.get<double>("grid spacing")), "dx > 0 (m)");
-    for (const char* k : {"domain min", "domain max"}) {
-      const auto a = m.get<Array<double>>(k);
-      if (static_cast<int>(a.size()) != dim) bad(std::string("MPM/") + k, Teuchos::toString(a), std::to_string(dim) + " components");
-    }
-    const int ppc = m.get<int>("particles per cell");
-    const bool ok = dim == 2 ? (ppc == 1 || ppc == 4 || ppc == 9 || ppc == 16) : (ppc == 1 || ppc == 8 || ppc == 27);
-    if (!ok) bad("MPM/particles per cell", std::to_string(ppc), dim == 2 ? "1, 4, 9 or 16" : "1, 8 or 27");
-  }
-  const auto& c = raw.sublist("Contact");
-  for (const char* k : {"dhat", "kappa", "eps_v"})
-    if (!(c.get<double>(k) > 0)) bad(std::string("Contact/") + k, num(c.get<double>(k)), "a positive value");
-  if (!(c.get<double>("friction") >= 0)) bad("Contact/friction", num(c.get<double>("friction")), "mu >= 0");
-  if (c.get<int>("friction iterations") < 1)
-    bad("Contact/friction iterations", std::to_string(c.get<int>("friction iterations")), ">= 1");
-  const std::string fb = c.get<std::string>("force body");
-  if (!fb.empty() && !raw.sublist("FEM Bodies").isSublist(fb))
-    bad("Contact/force body", "'" + fb + "'", "the name of an FEM body");
   return s;
 }
 
@@ -148,7 +125,7 @@ ContactParams contact_from(const ParameterList& p) {
 std::array<double, 3> vec3(const Array<double>& a, int dim, const std::string& key) {
   std::array<double, 3> v{0, 0, 0};
   if (a.empty()) return v;
-  if (static_cast<int>(a.size()) != dim) bad(key, Teuchos::toString(a), std::to_string(dim) + " components");
+  if (static_cast<int>(a.size()) != dim) bad(key, list(a), std::to_string(dim) + " components");
   for (int i = 0; i < dim; ++i) v[i] = a[i];
   return v;
 }
@@ -163,7 +140,7 @@ MeshData load_mesh(const ParameterList& mesh, const std::string& key, const std:
       bad(key + "/file", "'" + file + "'", "an existing Gmsh .msh file (looked for " + p.string() + ")");
     return read_gmsh_msh4(p.string(), dim);
   }
-  if (shape == "none") bad(key, "{no file, shape none}", "a 'file' or a 'shape'");
+  if (shape == "none") bad(key + "/shape", "'none' (and no 'file')", "a shape to mesh, or a 'file'");
   ShapeSpec spec;
   spec.kind = shape;
   const auto c = mesh.get<Array<double>>("center");
@@ -176,7 +153,7 @@ MeshData load_mesh(const ParameterList& mesh, const std::string& key, const std:
   try {
     return mesh_shape(spec, dim);
   } catch (const std::invalid_argument& e) {
-    throw std::invalid_argument("scene key '" + key + "': " + e.what());
+    rethrow_under(key, shape, e);
   }
 }
 
@@ -192,7 +169,7 @@ MotionSegment segment_from(const ParameterList& s, int dim, const std::string& k
   seg.center = vec3(s.get<Array<double>>("center"), dim, key + "/center");
   const auto ax = s.get<Array<double>>("axis");
   if (!ax.empty()) {
-    if (ax.size() != 3) bad(key + "/axis", Teuchos::toString(ax), "3 components");
+    if (ax.size() != 3) bad(key + "/axis", list(ax), "3 components");
     seg.axis = {ax[0], ax[1], ax[2]};
     if (ax[0] * ax[0] + ax[1] * ax[1] + ax[2] * ax[2] == 0) bad(key + "/axis", "[0,0,0]", "a non-zero axis");
   }
@@ -203,7 +180,7 @@ MotionSegment segment_from(const ParameterList& s, int dim, const std::string& k
 
 template <int dim>
 Vec<dim> vecd(const Array<double>& a, const std::string& key) {
-  if (static_cast<int>(a.size()) != dim) bad(key, Teuchos::toString(a), std::to_string(dim) + " components");
+  if (static_cast<int>(a.size()) != dim) bad(key, list(a), std::to_string(dim) + " components");
   Vec<dim> v;
   for (int i = 0; i < dim; ++i) v(i) = a[i];
   return v;
@@ -256,7 +233,7 @@ void build_mpm(const Scene& scene, const std::vector<std::string>& mat_names, Si
       part = sample_particles<dim>(shape, dx, m.get<int>("particles per cell"), setup.materials[mat].density,
                                    body_id, mat);
     } catch (const std::invalid_argument& e) {
-      throw std::invalid_argument("scene key '" + key + "': " + e.what());
+      rethrow_under(key, shape.kind, e);
     }
     const auto v0 = vec3(b.get<Array<double>>("initial velocity"), dim, key + "/initial velocity");
     for (int d = 0; d < dim; ++d) Kokkos::deep_copy(Kokkos::subview(part.v, Kokkos::ALL(), d), v0[d]);
@@ -264,6 +241,8 @@ void build_mpm(const Scene& scene, const std::vector<std::string>& mat_names, Si
     mpm.body_names.push_back(name);
   }
   mpm.particles = concatenate(parts);
+  const int ppc = m.get<int>("particles per cell");
+  check_mpm_start(mpm, dx / std::round(std::pow(ppc, 1.0 / dim)));
   setup.mpm = mpm;
   const auto& lss = p.sublist("Level Sets");
   for (auto it = lss.begin(); it != lss.end(); ++it) {
@@ -279,7 +258,7 @@ void build_mpm(const Scene& scene, const std::vector<std::string>& mat_names, Si
       ls.point = vec3(l.get<Array<double>>("point"), dim, key + "/point");  // default: origin
       const Vec<dim> n = vecd<dim>(l.get<Array<double>>("normal"), key + "/normal");
       if (!(n.norm() > 0) || !std::isfinite(n.norm()))
-        bad(key + "/normal", Teuchos::toString(l.get<Array<double>>("normal")), "a finite non-zero normal");
+        bad(key + "/normal", list(l.get<Array<double>>("normal")), "a finite non-zero normal");
       const Vec<dim> u = n.normalized();
       for (int d = 0; d < dim; ++d) ls.normal[d] = u(d);
     } else if (ls.kind == LevelSetKind::Sine) {
@@ -298,12 +277,13 @@ void build_mpm(const Scene& scene, const std::vector<std::string>& mat_names, Si
         ls.box_min[d] = lo(d);
         ls.box_max[d] = hi(d);
         if (!(hi(d) > lo(d)))
-          bad(key + "/box max", Teuchos::toString(l.get<Array<double>>("box max")),
-              "every component > box min's (" + Teuchos::toString(l.get<Array<double>>("box min")) + ")");
+          bad(key + "/box max", list(l.get<Array<double>>("box max")),
+              "every component > box min's (" + list(l.get<Array<double>>("box min")) + ")");
       }
     }
     setup.level_sets.push_back(ls);
   }
+  check_level_set_start(*setup.mpm, setup.level_sets);
 }
 
 }  // namespace
@@ -322,20 +302,12 @@ Scene load_scene(const std::string& path, const std::vector<std::string>& overri
   std::stringstream ss;
   ss << in.rdbuf();
   const auto dir = std::filesystem::absolute(path).parent_path().string();
-  Scene s = load_scene_from_string(ss.str(), dir, overrides);
-  s.path = path;
-  return s;
+  return finish(*parse_scene_yaml(ss.str(), "scene file '" + path + "'"), path, dir, overrides);
 }
 
 Scene load_scene_from_string(const std::string& yaml, const std::string& base_dir,
                              const std::vector<std::string>& overrides) {
-  Teuchos::RCP<ParameterList> raw;
-  try {
-    raw = Teuchos::getParametersFromYamlString(yaml);
-  } catch (const std::exception& e) {
-    throw std::invalid_argument(std::string("scene is not valid YAML: ") + e.what());
-  }
-  return finish(*raw, "", base_dir, overrides);
+  return finish(*parse_scene_yaml(yaml, "scene"), "", base_dir, overrides);
 }
 
 template <int dim>
@@ -382,9 +354,11 @@ SimulationSetup<dim> build_setup(const Scene& scene) {
         }
         for (long long n : f->second) mo.nodes.push_back(node_offset + static_cast<LO>(n));
       } else {
-        if (static_cast<int>(lo.size()) != dim || static_cast<int>(hi.size()) != dim)
-          bad(bkey, "{box min " + Teuchos::toString(lo) + ", box max " + Teuchos::toString(hi) + "}",
-              "a 'node set' or 'box min' and 'box max' with " + std::to_string(dim) + " components");
+        for (const auto& [k, a] : {std::pair{"box min", lo}, std::pair{"box max", hi}})
+          if (static_cast<int>(a.size()) != dim)
+            bad(bkey + "/" + k, list(a),
+                std::to_string(dim) + " components (no 'node set' is given: 'box min' and 'box max' select the "
+                "nodes)");
         for (std::size_t n = 0; n < in.mesh.num_nodes(); ++n) {
           bool inside = true;
           for (int c = 0; c < dim; ++c) {
@@ -394,7 +368,9 @@ SimulationSetup<dim> build_setup(const Scene& scene) {
           if (inside) mo.nodes.push_back(node_offset + static_cast<LO>(n));
         }
       }
-      if (mo.nodes.empty()) bad(bkey, "(selection)", "at least one node in the selection");
+      if (mo.nodes.empty())
+        throw std::invalid_argument("scene keys '" + bkey + "/box min' = " + list(lo) + " and '" + bkey +
+                                    "/box max' = " + list(hi) + ": expected a box holding at least one node of the mesh");
       const auto& motion = bc.sublist("Motion");
       for (auto sit = motion.begin(); sit != motion.end(); ++sit)
         mo.segments.push_back(segment_from(motion.sublist(motion.name(sit)), dim, bkey + "/Motion/" + motion.name(sit)));
@@ -405,6 +381,7 @@ SimulationSetup<dim> build_setup(const Scene& scene) {
     setup.bodies.push_back(std::move(in));
   }
   build_mpm<dim>(scene, mat_names, setup);
+  check_friction_pairs(p);
   if (setup.mpm && !setup.bodies.empty() && p.sublist("Contact").get<bool>("enabled")) setup.contact = contact_from(p);
   const auto& time = p.sublist("Time");
   setup.dt = time.get<double>("dt");

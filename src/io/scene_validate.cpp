@@ -1,8 +1,14 @@
 #include "io/scene_validate.hpp"
 
 #include <Teuchos_Array.hpp>
+#include <Teuchos_StandardParameterEntryValidators.hpp>
+#include <cctype>
+#include <cmath>
+#include <cstdlib>
 #include <sstream>
 #include <stdexcept>
+
+#include "io/scene_yaml.hpp"
 
 namespace bfemp {
 
@@ -29,10 +35,13 @@ std::string type_name(const Teuchos::ParameterEntry& e) {
   if (e.isType<bool>()) return "boolean";
   if (e.isType<Array<double>>()) return "list of real numbers";
   if (e.isType<Array<int>>()) return "list of integers";
+  if (e.isType<Array<std::string>>()) return "list of strings";
   return e.getAny().typeName();
 }
 
-// Promotes integers given where reals are expected (YAML reads "1" as int).
+// Promotes integers given where reals are expected (YAML reads "1" as int),
+// 0 and 1 where a boolean is expected, and whole reals (2.0, 1e3) within
+// range where an integer is expected.
 void promote(ParameterList& list, const std::string& key, const Teuchos::ParameterEntry& want) {
   const auto& have = list.getEntry(key);
   if (want.isType<double>() && have.isType<int>()) {
@@ -40,7 +49,66 @@ void promote(ParameterList& list, const std::string& key, const Teuchos::Paramet
   } else if (want.isType<Array<double>>() && have.isType<Array<int>>()) {
     const auto ai = list.get<Array<int>>(key);
     list.set(key, Array<double>(ai.begin(), ai.end()));
+  } else if (want.isType<bool>() && have.isType<int>() && (list.get<int>(key) == 0 || list.get<int>(key) == 1)) {
+    list.set(key, list.get<int>(key) == 1);
+  } else if (want.isType<int>() && have.isType<double>()) {
+    const double v = list.get<double>(key);
+    if (v == std::floor(v) && std::abs(v) <= 2147483647.0) list.set(key, static_cast<int>(v));
   }
+}
+
+// What a mistyped value is, for the message: a number out of range or NaN
+// written as text, a key without a value, or its type.
+// True for text that names a number no double holds: 1e400, nan, .inf, -.Inf
+// (the YAML parser leaves them strings).
+bool non_finite_number(const std::string& t) {
+  std::string l;
+  for (char c : t) l += static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  if (!l.empty() && (l[0] == '+' || l[0] == '-')) l = l.substr(1);
+  if (l == ".nan" || l == ".inf" || l == "nan" || l == "inf" || l == "infinity") return true;
+  char* end = nullptr;
+  const double v = std::strtod(t.c_str(), &end);
+  return !t.empty() && end == t.c_str() + t.size() && !std::isfinite(v);
+}
+
+std::string what_it_is(const Teuchos::ParameterEntry& have, const Teuchos::ParameterEntry& want) {
+  if (have.isList()) return have.getValue<ParameterList>(nullptr).numParams() == 0 ? "no value" : "a map";
+  if (have.isType<std::string>() && (want.isType<double>() || want.isType<int>())) {
+    const std::string t = Teuchos::getValue<std::string>(have);
+    if (non_finite_number(t)) return "not a finite number";
+    if (t.empty()) return "an empty string";
+  }
+  if (have.isType<Array<std::string>>() && want.isType<Array<double>>())
+    for (const auto& t : Teuchos::getValue<Array<std::string>>(have))
+      if (non_finite_number(t)) return "a component '" + t + "' is not a finite number";
+  return "wrong type " + type_name(have);
+}
+
+template <class T>
+std::string shown_array(const Array<T>& a) {
+  std::ostringstream s;
+  s << "[";
+  for (typename Array<T>::size_type i = 0; i < a.size(); ++i) s << (i ? ", " : "") << a[i];
+  s << "]";
+  return s.str();
+}
+
+std::string shown(const Teuchos::ParameterEntry& e) {
+  if (e.isList()) return e.getValue<ParameterList>(nullptr).numParams() == 0 ? "(nothing)" : "{...}";
+  if (e.isType<std::string>()) return "'" + Teuchos::getValue<std::string>(e) + "'";
+  if (e.isType<Array<double>>()) return shown_array(Teuchos::getValue<Array<double>>(e));
+  if (e.isType<Array<int>>()) return shown_array(Teuchos::getValue<Array<int>>(e));
+  if (e.isType<Array<std::string>>()) return shown_array(Teuchos::getValue<Array<std::string>>(e));
+  return Teuchos::toString(e.getAny());
+}
+
+// Non-finite reals (possible through --set and programmatic lists) are refused.
+void require_finite(const Teuchos::ParameterEntry& e, const std::string& where) {
+  bool ok = true;
+  if (e.isType<double>()) ok = std::isfinite(Teuchos::getValue<double>(e));
+  if (e.isType<Array<double>>())
+    for (double v : Teuchos::getValue<Array<double>>(e)) ok = ok && std::isfinite(v);
+  if (!ok) throw std::invalid_argument("scene key '" + where + "' = " + shown(e) + ": expected finite numbers");
 }
 
 }  // namespace
@@ -58,22 +126,30 @@ void validate_scene_list(ParameterList& list, const ParameterList& schema, const
     const auto& have = list.getEntry(key);
     if (have.isList() != want.isList() || (!want.isList() && have.getAny().type() != want.getAny().type())) {
       std::ostringstream msg;
-      msg << "scene key '" << where << "' = " << (have.isList() ? "{...}" : Teuchos::toString(have.getAny()))
-          << ": wrong type " << type_name(have) << ", expected " << type_name(want);
+      msg << "scene key '" << where << "' = " << shown(have) << ": " << what_it_is(have, want) << ", expected "
+          << type_name(want);
+      if (want.isType<bool>()) msg << " (true or false)";
       throw std::invalid_argument(msg.str());
     }
+    require_finite(have, where);
     if (!want.isList() && !want.validator().is_null()) {
       try {
         want.validator()->validate(have, key, path);
       } catch (const std::exception&) {
         std::ostringstream msg;
-        msg << "scene key '" << where << "' = '" << Teuchos::toString(have.getAny())
-            << "': not a valid value; expected " << want.docString();
-        if (const auto valid = want.validator()->validStringValues(); !valid.is_null()) {
-          msg << " (one of:";
-          for (const auto& v : *valid) msg << " '" << v << "'";
-          msg << ")";
+        msg << "scene key '" << where << "' = " << shown(have) << ": expected ";
+        const auto& v = *want.validator();
+        if (const auto valid = v.validStringValues(); !valid.is_null()) {
+          msg << "one of";
+          for (decltype(valid->size()) i = 0; i < valid->size(); ++i) msg << (i ? ", '" : " '") << (*valid)[i] << "'";
+        } else if (const auto* d = dynamic_cast<const Teuchos::EnhancedNumberValidator<double>*>(&v)) {
+          msg << "a value in [" << d->getMin() << ", " << d->getMax() << "]";
+        } else if (const auto* n = dynamic_cast<const Teuchos::EnhancedNumberValidator<int>*>(&v)) {
+          msg << "an integer in [" << n->getMin() << ", " << n->getMax() << "]";
+        } else {
+          msg << "a valid value";
         }
+        if (!want.docString().empty()) msg << " (" << want.docString() << ")";
         throw std::invalid_argument(msg.str());
       }
     }
@@ -116,17 +192,43 @@ void apply_scene_override(ParameterList& list, const ParameterList& schema, cons
     const auto slash = path.find('/', start);
     const std::string part = path.substr(start, slash == std::string::npos ? std::string::npos : slash - start);
     if (slash == std::string::npos) {
-      if (!s->isParameter(part) || s->isSublist(part))
-        throw std::invalid_argument("--set '" + path + "': unknown key '" + part + "'; expected one of " +
-                                    valid_names(*s));
+      const std::string what = "--set '" + path + "'";
+      if (s->numParams() == 0 && !scene_is_container(parent)) {  // free-form: Ifpack2, Friction Pairs
+        l->setEntry(part, parse_yaml_value(value, what));
+        return;
+      }
+      if (s->isSublist(part))
+        throw std::invalid_argument(what + ": '" + part + "' is a sublist; set one of its keys, '" + path +
+                                    "/<key>=value'");
+      if (!s->isParameter(part))
+        throw std::invalid_argument(what + ": unknown key '" + part + "'; expected one of " + valid_names(*s));
       const auto& want = s->getEntry(part);
+      if (want.isType<std::string>()) {  // text as written; quotes optional
+        std::string t = value;
+        if (t.size() >= 2 && (t.front() == '\'' || t.front() == '"') && t.back() == t.front())
+          t = t.substr(1, t.size() - 2);
+        l->set(part, t);
+        return;
+      }
       try {
-        if (want.isType<double>()) l->set(part, std::stod(value));
-        else if (want.isType<int>()) l->set(part, std::stoi(value));
-        else if (want.isType<Array<double>>()) l->set(part, Teuchos::fromStringToArray<double>(value));
-        else l->set(part, value);
-      } catch (const std::exception&) {
-        throw std::invalid_argument("--set '" + path + "' = '" + value + "': expected " + type_name(want));
+        l->setEntry(part, parse_yaml_value(value, what));
+      } catch (const std::invalid_argument& e) {
+        throw std::invalid_argument(std::string(e.what()) + "; expected " + type_name(want));
+      }
+      promote(*l, part, want);
+      const auto& have = l->getEntry(part);
+      if (have.isList() || have.getAny().type() != want.getAny().type()) {
+        std::string expected = type_name(want);
+        if (want.isType<bool>()) expected += " (true, false, True, False, yes, no, 1 or 0)";
+        if (want.isType<Array<double>>()) expected += " written [x, y] (or {x, y})";
+        if (want.isType<int>()) expected += " (a whole number)";
+        throw std::invalid_argument(what + " = '" + value + "': " + what_it_is(have, want) + ", expected " +
+                                    expected);
+      }
+      try {
+        require_finite(have, path);
+      } catch (const std::invalid_argument&) {
+        throw std::invalid_argument(what + " = '" + value + "': expected finite numbers");
       }
       return;
     }

@@ -198,7 +198,7 @@ bfemp:
     block: {material: soft, shape: box, center: [0.5, 0.5], size: [0.2, 0.2]}
   Level Sets:
     waves: {type: sine, slip: true, height: 0.9, amplitude: 0.025, wavelength: 0.1, solid: above, velocity: [0.0, -1.0]}
-    incline: {type: half-plane, slip: true, point: [0.0, 0.2], normal: [-0.5, 1.0]}
+    incline: {type: half-plane, slip: true, point: [0.0, 0.0], normal: [-0.5, 1.0]}
     walls: {type: box, slip: true, box min: [-1.0, -1.0], box max: [0.05, 2.0]}
 ...
 )";
@@ -225,4 +225,46 @@ bfemp:
                  {"Level Sets/walls/box max", "> box min"});
   expect_message(error_of(with("velocity: [0.0, -1.0]", "velocity: [-1.0]")),
                  {"Level Sets/waves/velocity", "2 components"});
+  // Particles that start inside a level set's solid.
+  expect_message(error_of(with("height: 0.9", "height: 0.5")),
+                 {"MPM body 'block'", "inside the solid of level set 'waves'", "Level Sets/waves"});
+  expect_message(error_of(with("box max: [0.05, 2.0]", "box max: [0.45, 2.0]")),
+                 {"MPM body 'block'", "level set 'walls'"});
+}
+
+TEST(SceneErrors, MpmStartStateIsCheckedBeforeStepping) {
+  const std::string mpm = R"(%YAML 1.1
+---
+bfemp:
+  dimension: 2
+  Materials:
+    soft: {E: 1.0e5, nu: 0.3, density: 1000.0}
+  MPM:
+    grid spacing: 0.05
+    domain min: [0.0, 0.0]
+    domain max: [1.0, 1.0]
+  MPM Bodies:
+    left: {material: soft, shape: disk, center: [0.3, 0.5], outer radius: 0.1}
+    right: {material: soft, shape: ring, center: [0.7, 0.5], inner radius: 0.05, outer radius: 0.1}
+...
+)";
+  auto with = [&](const std::string& from, const std::string& to) {
+    std::string s = mpm;
+    EXPECT_NE(s.find(from), std::string::npos) << from;
+    s.replace(s.find(from), from.size(), to);
+    return s;
+  };
+  EXPECT_EQ(error_of(mpm), "");
+  expect_message(error_of(with("center: [0.7, 0.5]", "center: [1.05, 0.5]")),
+                 {"MPM body 'right'", "outside the MPM grid domain", "when particles leave: extend"});
+  expect_message(error_of(with("domain min: [0.0, 0.0]", "domain min: [0.5, 0.0]")),
+                 {"MPM body 'left'", "outside the MPM grid domain"});
+  // The disk inside the ring's hole does not overlap it; on the ring it does.
+  EXPECT_EQ(error_of(with("center: [0.3, 0.5], outer radius: 0.1", "center: [0.7, 0.5], outer radius: 0.04")), "");
+  expect_message(error_of(with("center: [0.3, 0.5]", "center: [0.62, 0.5]")),
+                 {"MPM body 'left' and MPM body 'right' overlap", "center"});
+  expect_message(error_of(with("outer radius: 0.1}\n    right", "outer radius: 0.001}\n    right")),
+                 {"MPM Bodies/left", "no particles"});
+  expect_message(error_of(with("domain max: [1.0, 1.0]", "domain max: [1.0, 0.0]")),
+                 {"'MPM/domain min' = [0, 0]", "'MPM/domain max' = [1, 0]", "domain max > domain min"});
 }
