@@ -30,12 +30,27 @@ template <int dim>
 KOKKOS_INLINE_FUNCTION StressDerivative<dim> neo_hookean_stress_derivative_psd(const Mat<dim>& F,
                                                                                const LameParameters& p) {
   constexpr int n = dim * dim;
-  Eigen::JacobiSVD<Mat<dim>> svd(F, Eigen::ComputeFullU | Eigen::ComputeFullV);
-  Mat<dim> U = svd.matrixU(), V = svd.matrixV();
-  Vec<dim> s = svd.singularValues();
-  if (U.determinant() < 0) {  // J > 0: det U and det V share their sign
-    U.col(dim - 1) *= -1.0;
-    V.col(dim - 1) *= -1.0;
+  // SVD through the symmetric eigenproblem of F^T F = V diag(s^2) V^T
+  // (cheaper than JacobiSVD): s_min then carries a relative error of about
+  // eps (s_max / s_min)^2, so below s_min / s_max = 0.05 the one-sided Jacobi
+  // SVD is used instead. det V = 1 by a column flip; U = F V diag(1/s) then
+  // has det U = det F / (det V prod s) = 1.
+  const Eigen::SelfAdjointEigenSolver<Mat<dim>> ev(F.transpose() * F);
+  Mat<dim> U, V = ev.eigenvectors();
+  Vec<dim> s;
+  for (int i = 0; i < dim; ++i) s(i) = std::sqrt(std::max(ev.eigenvalues()(i), 0.0));
+  if (s(0) >= 0.05 * s(dim - 1)) {  // eigenvalues ascending
+    if (V.determinant() < 0) V.col(0) *= -1.0;
+    U = F * V * s.cwiseInverse().asDiagonal();
+  } else {
+    const Eigen::JacobiSVD<Mat<dim>> svd(F, Eigen::ComputeFullU | Eigen::ComputeFullV);
+    U = svd.matrixU();
+    V = svd.matrixV();
+    s = svd.singularValues();
+    if (U.determinant() < 0) {  // J > 0: det U and det V share their sign
+      U.col(dim - 1) *= -1.0;
+      V.col(dim - 1) *= -1.0;
+    }
   }
   const double logJ = std::log(F.determinant());
   const double c = p.mu - p.lambda * logJ;
