@@ -3,12 +3,13 @@
 # threads and merges both runs into one JSON with the machine's description.
 # Builds nothing: build first with  ninja -C build bench_newton
 #
-#   perf/run_benchmarks.sh [--bench bench_newton|bench_mpm_newton] [--build-dir DIR]
+#   perf/run_benchmarks.sh [--bench bench_newton|bench_mpm_newton|bench_ccd] [--build-dir DIR]
 #                          [--out FILE] [--threads "1 2"]
 #                          [--wait-quiet SECONDS] [-- options passed to the benchmark]
 #
 # Defaults: --bench bench_newton, --build-dir build, --out build/perf/newton.json
-# (bench_mpm_newton: build/perf/mpm_newton.json), --threads "1 2".
+# (bench_mpm_newton: build/perf/mpm_newton.json; bench_ccd: build/perf/ccd.json),
+# --threads "1 2" (bench_ccd: "1"; it times one query per call, serially).
 # --wait-quiet S: before each thread count, wait up to S seconds for the CPUs
 # to be >= 95% idle for 6 s (the machine is shared; see perf/README.md).
 # Compare the result with the stored baseline:
@@ -19,7 +20,7 @@ set -euo pipefail
 repo="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 build_dir="$repo/build"
 out=""
-threads="1 2"
+threads=""
 wait_quiet=0
 extra=()
 bench=bench_newton
@@ -38,8 +39,10 @@ done
 case "$bench" in
   bench_newton) bench_json=newton; bench_name=newton_iteration ;;
   bench_mpm_newton) bench_json=mpm_newton; bench_name=mpm_newton_iteration ;;
-  *) echo "run_benchmarks.sh: --bench '$bench': expected bench_newton or bench_mpm_newton" >&2; exit 2 ;;
+  bench_ccd) bench_json=ccd; bench_name=ccd_queries; [[ -n "$threads" ]] || threads="1" ;;
+  *) echo "run_benchmarks.sh: --bench '$bench': expected bench_newton, bench_mpm_newton or bench_ccd" >&2; exit 2 ;;
 esac
+[[ -n "$threads" ]] || threads="1 2"
 [[ -n "$out" ]] || out="$build_dir/perf/$bench_json.json"
 bin="$build_dir/perf/$bench"
 if [[ ! -x "$bin" ]]; then
