@@ -14,6 +14,8 @@
 #include "io/shape_mesher.hpp"
 #include "mpm/sampling.hpp"
 
+#include "io/scene_messages.hpp"
+
 namespace bfemp {
 
 using Teuchos::Array;
@@ -21,21 +23,9 @@ using Teuchos::ParameterList;
 
 namespace {
 
-[[noreturn]] void bad(const std::string& key, const std::string& value, const std::string& expected) {
-  throw std::invalid_argument("scene key '" + key + "' = " + value + ": expected " + expected);
-}
-
-std::string num(double v) {
-  std::ostringstream s;
-  s << v;
-  return s.str();
-}
-
-std::string list(const Array<double>& a) {
-  std::string s = "[";
-  for (Array<double>::size_type i = 0; i < a.size(); ++i) s += (i ? ", " : "") + num(a[i]);
-  return s + "]";
-}
+using scene_msg::bad;
+using scene_msg::list;
+using scene_msg::num;
 
 // Rethrows a sampling or meshing error ("sampling field 'outer_radius' = 0:
 // expected ...") under the scene key it came from ("scene key 'MPM

@@ -7,6 +7,8 @@
 #include <stdexcept>
 #include <unordered_map>
 
+#include "io/scene_messages.hpp"
+
 namespace bfemp {
 
 using Teuchos::Array;
@@ -14,21 +16,9 @@ using Teuchos::ParameterList;
 
 namespace {
 
-[[noreturn]] void bad(const std::string& key, const std::string& value, const std::string& expected) {
-  throw std::invalid_argument("scene key '" + key + "' = " + value + ": expected " + expected);
-}
-
-std::string num(double v) {
-  std::ostringstream s;
-  s << v;
-  return s.str();
-}
-
-std::string list(const Array<double>& a) {
-  std::string s = "[";
-  for (Array<double>::size_type i = 0; i < a.size(); ++i) s += (i ? ", " : "") + num(a[i]);
-  return s + "]";
-}
+using scene_msg::bad;
+using scene_msg::list;
+using scene_msg::num;
 
 void positive(const ParameterList& l, const std::string& path, const std::string& key, const std::string& what) {
   const double v = l.get<double>(key);
