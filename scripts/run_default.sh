@@ -18,5 +18,5 @@ Output of the default scene (inputs/default_contact.yaml) in out/:
   ParaView:     out/bfemp.xdmf  (File > Open, reader Xdmf3ReaderT; data in out/bfemp.h5)
   diagnostics:  out/diagnostics.csv
   plot:         $plot
-Look at: the disk (fem) slides, spins up and rolls over the floor (particles: show as Point Gaussian); momentum_x in the plot falls until it rolls at 1.33 m/s from t = 0.14 s.
+Look at: the disk (fem) slides, spins up and rolls over the floor of particles; momentum_x in the plot falls until it rolls at 1.33 m/s from t = 0.14 s.
 EOF
