@@ -130,8 +130,9 @@ const std::vector<long long>& Checkpoint::ints(const std::string& name, long row
   return field(*this, name, rows, true).ints;
 }
 
-void write_checkpoint(const std::string& path, const Checkpoint& c) {
-  const std::string tmp = path + ".tmp";
+namespace {
+
+void write_unsynced(const std::string& tmp, const Checkpoint& c) {
   {
     Quiet quiet;
     H fapl{fapl_no_locking(), H5Pclose};
@@ -156,16 +157,57 @@ void write_checkpoint(const std::string& path, const Checkpoint& c) {
         write_array(g.id, tmp, name, H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, a.real.data(), a.rows, a.cols);
     }
     ok(H5Fflush(f.id, H5F_SCOPE_GLOBAL), tmp, "flush failed");
+    H5Gclose(g.id);
+    g.id = -1;
+    const hid_t file = f.id;
+    f.id = -1;
+    ok(H5Fclose(file), tmp, "close failed");
   }
-  fsync_path(tmp);
+}
+
+}  // namespace
+
+void write_checkpoint(const std::string& path, const Checkpoint& c) {
+  const std::string tmp = path + ".tmp";
+  try {
+    write_unsynced(tmp, c);
+    fsync_path(tmp);
+  } catch (...) {
+    std::remove(tmp.c_str());  // a failed write (disk full, ...) leaves the old checkpoint and no .tmp
+    throw;
+  }
   if (std::rename(tmp.c_str(), path.c_str()) != 0) {
     const std::string err = std::strerror(errno);
     std::remove(tmp.c_str());
     throw std::runtime_error("checkpoint '" + path + "': rename from " + tmp + " failed (" + err + ")");
   }
+  // The rename itself survives a power loss only once the directory is synced.
+  const std::string dir = std::filesystem::path(path).parent_path().string();
+  const int fd = ::open(dir.empty() ? "." : dir.c_str(), O_RDONLY | O_DIRECTORY);
+  if (fd >= 0) {
+    ::fsync(fd);
+    ::close(fd);
+  }
 }
 
+
+namespace {
+Checkpoint read_checkpoint_unchecked(const std::string& path);
+}
+
+// Any failure to read the file is bad input (exit 2), naming the file.
 Checkpoint read_checkpoint(const std::string& path) {
+  try {
+    return read_checkpoint_unchecked(path);
+  } catch (const std::invalid_argument&) {
+    throw;
+  } catch (const std::exception& e) {
+    throw std::invalid_argument(std::string(e.what()) + " (a damaged or foreign checkpoint)");
+  }
+}
+
+namespace {
+Checkpoint read_checkpoint_unchecked(const std::string& path) {
   if (!std::filesystem::is_regular_file(path))
     throw std::invalid_argument("checkpoint '" + path + "' does not exist (a run writes it at its end, on SIGINT/SIGTERM "
                                 "and every 'Output/checkpoint every' steps)");
@@ -228,5 +270,6 @@ Checkpoint read_checkpoint(const std::string& path) {
   }
   return c;
 }
+}  // namespace
 
 }  // namespace bfemp

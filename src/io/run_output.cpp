@@ -44,7 +44,8 @@ RunOutput<dim>::RunOutput(const std::string& dir, const Scene& scene, const Simu
   if (resume) {
     h5_ = std::make_unique<Hdf5FrameWriter>(dir + "/bfemp.h5", resume->frames);
     csv_ = std::make_unique<DiagnosticsCsv>(dir + "/diagnostics.csv", diagnostics_columns(), ints, resume->step);
-    for (int i = 0; i < resume->frames; ++i) xdmf_.add_frame(xdmf_frame(sim, i, h5_->frame_time(i)));
+    for (int i = 0; i < resume->frames; ++i) xdmf_.add_frame(xdmf_frame(sim, i, h5_->frame_time(i)), false);
+    xdmf_.write();
     frame_ = resume->frames;
   } else {
     h5_ = std::make_unique<Hdf5FrameWriter>(dir + "/bfemp.h5");

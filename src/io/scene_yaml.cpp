@@ -103,7 +103,10 @@ struct Reporter {
 // past its end (s.size() when unterminated: the parser reports that).
 // line0 is the line of s[0].
 std::size_t scan_flow(const std::string& s, std::size_t i, const std::string& path, int line0,
-                      const Reporter& rep) {
+                      const Reporter& rep, int depth = 0) {
+  if (depth > 256)  // recursion bound: a scene never nests this deep
+    throw std::invalid_argument(rep.label + " line " + std::to_string(line0) + ": key '" + path +
+                                "': flow collections nested deeper than 256 levels");
   auto line_at = [&](std::size_t pos) {
     int l = line0;
     for (std::size_t k = 0; k < pos && k < s.size(); ++k) l += s[k] == '\n';
@@ -146,7 +149,7 @@ std::size_t scan_flow(const std::string& s, std::size_t i, const std::string& pa
     const std::size_t start = i;
     std::string key;
     if (s[i] == '{' || s[i] == '[') {
-      i = scan_flow(s, i, path + "[" + std::to_string(item) + "]", line_at(i), rep);
+      i = scan_flow(s, i, path + "[" + std::to_string(item) + "]", line_at(i), rep, depth + 1);
     } else {
       key = scalar(i);
     }
@@ -159,7 +162,7 @@ std::size_t scan_flow(const std::string& s, std::size_t i, const std::string& pa
         if (!fresh) rep.duplicate(join(path, key), line, it->second);
       }
       skip_ws(i);
-      if (i < s.size() && (s[i] == '{' || s[i] == '[')) i = scan_flow(s, i, join(path, key), line_at(i), rep);
+      if (i < s.size() && (s[i] == '{' || s[i] == '[')) i = scan_flow(s, i, join(path, key), line_at(i), rep, depth + 1);
       else if (i < s.size() && s[i] != ',' && s[i] != close) scalar(i);
     }
     if (i == start) ++i;  // no progress on a stray character

@@ -145,7 +145,7 @@ XdmfSeriesWriter::XdmfSeriesWriter(std::string xdmf_path, std::string h5_name)
     throw std::invalid_argument("XDMF file '" + xdmf_path_ + "': empty HDF5 file name");
 }
 
-void XdmfSeriesWriter::add_frame(const XdmfFrame& frame) {
+void XdmfSeriesWriter::add_frame(const XdmfFrame& frame, bool write) {
   const std::string frame_name = "frame_" + std::to_string(frames_.size());
   if (!std::isfinite(frame.time))
     bad(xdmf_path_, frame_name, "time = " + exact(frame.time) + ", expected a finite value");
@@ -168,6 +168,7 @@ void XdmfSeriesWriter::add_frame(const XdmfFrame& frame) {
     xml += indent + "</Grid>\n";
   }
   frames_.push_back(std::move(xml));
+  if (!write) return;
   try {
     write_file_atomically(xdmf_path_, render());
   } catch (...) {
@@ -175,6 +176,8 @@ void XdmfSeriesWriter::add_frame(const XdmfFrame& frame) {
     throw;
   }
 }
+
+void XdmfSeriesWriter::write() const { write_file_atomically(xdmf_path_, render()); }
 
 std::string XdmfSeriesWriter::render() const {
   std::string s =

@@ -58,7 +58,10 @@ class XdmfSeriesWriter {
 
   // Validates the frame (std::invalid_argument naming the grid and field),
   // appends it and rewrites the .xdmf atomically.
-  void add_frame(const XdmfFrame& frame);
+  // With write = false the file is left as it is (restart adds the kept
+  // frames in a batch, then writes once with the next add_frame or write()).
+  void add_frame(const XdmfFrame& frame, bool write = true);
+  void write() const;
 
   std::size_t num_frames() const { return frames_.size(); }
   const std::string& path() const { return xdmf_path_; }

@@ -7,7 +7,7 @@ volatile std::sig_atomic_t g_signal = 0;
 struct sigaction g_old_int, g_old_term;
 
 extern "C" void record_signal(int sig) {
-  if (g_signal == sig) {  // second time: give the default action back and re-raise
+  if (g_signal != 0) {  // a second signal: give the default action back and re-raise
     std::signal(sig, SIG_DFL);
     std::raise(sig);
     return;

@@ -2,8 +2,8 @@
 // Safe interruption of a run: while an InterruptGuard lives, SIGINT and SIGTERM
 // only record the signal (async-signal-safe); the run loop polls
 // pending_signal() after each completed step, writes a frame and a checkpoint,
-// closes its files and throws Interrupted. A second signal of the same kind
-// while one is pending restores the default action (a user pressing Ctrl-C
+// closes its files and throws Interrupted. A second signal (either kind) while
+// one is pending restores the default action (a user pressing Ctrl-C
 // twice wants out now). The previous handlers come back when the guard dies.
 #include <csignal>
 #include <stdexcept>

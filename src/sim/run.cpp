@@ -48,6 +48,15 @@ Checkpoint make_checkpoint(const Scene& scene, const RunOptions& opt, const Simu
   c.texts["scene_source"] = opt.scene_source.empty() ? resolved.str() : opt.scene_source;
   c.texts["overrides"] = opt.scene_source.empty() ? std::string() : join_lines(opt.overrides);
   c.texts["base_dir"] = std::filesystem::absolute(scene.base_dir.empty() ? "." : scene.base_dir).string();
+  {  // the rest mesh, so that a restart refuses a mesh file changed since
+    auto X0 = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), sim.mesh().rest_position);
+    auto cells = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), sim.mesh().elements.nodes);
+    c.put("fem_rest_position", std::vector<double>(X0.data(), X0.data() + X0.size()), dim);
+    std::vector<long long> conn(cells.size());
+    for (std::size_t e = 0; e < cells.extent(0); ++e)
+      for (int a = 0; a <= dim; ++a) conn[e * (dim + 1) + a] = cells(e, a);
+    c.put("fem_cells", std::move(conn), dim + 1);
+  }
   c.put("fem_x", st.fem_x, dim);
   c.put("fem_v", st.fem_v, dim);
   c.put("fem_a", st.fem_a, dim);
@@ -66,6 +75,24 @@ Checkpoint make_checkpoint(const Scene& scene, const RunOptions& opt, const Simu
     c.put("grid_extensions", std::vector<long long>{st.grid_extensions});
   }
   return c;
+}
+
+// The scene's FEM rest mesh must be the checkpoint's, bit for bit (a mesh
+// file regenerated between the run and the restart is refused).
+template <int dim>
+void check_same_mesh(const Checkpoint& c, const Simulation<dim>& sim) {
+  if (!c.has("fem_rest_position")) return;  // written by every run; kept optional for the reader
+  auto X0 = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), sim.mesh().rest_position);
+  auto cells = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), sim.mesh().elements.nodes);
+  const auto& x = c.real("fem_rest_position");
+  const auto& conn = c.ints("fem_cells");
+  bool same = x.size() == X0.size() && conn.size() == cells.size();
+  for (std::size_t i = 0; same && i < x.size(); ++i) same = x[i] == X0.data()[i];
+  for (std::size_t e = 0; same && e < cells.extent(0); ++e)
+    for (int a = 0; a <= dim; ++a) same = same && conn[e * (dim + 1) + a] == cells(e, a);
+  if (!same)
+    throw std::invalid_argument("restart: the scene's FEM mesh differs from the checkpoint's (a mesh file changed "
+                                "since the run?); restart needs the run's own mesh");
 }
 
 template <int dim>
@@ -130,7 +157,10 @@ RunSummary run_dim(const Scene& scene, const std::string& dir, const Teuchos::RC
     throw std::invalid_argument("restart: the checkpoint is " + std::to_string(opt.restart->dim) +
                                 "D, the scene " + std::to_string(dim) + "D");
   Simulation<dim> sim(build_setup<dim>(scene), comm);
-  if (opt.restart) sim.restore(checkpoint_state<dim>(*opt.restart));
+  if (opt.restart) {
+    check_same_mesh(*opt.restart, sim);
+    sim.restore(checkpoint_state<dim>(*opt.restart));
+  }
   const auto& mesh = sim.mesh();
   log << "FEM: " << mesh.num_nodes() << " nodes, " << mesh.num_cells() << " elements, "
       << mesh.num_nodes() * dim << " DOFs";
@@ -140,6 +170,9 @@ RunSummary run_dim(const Scene& scene, const std::string& dir, const Teuchos::RC
   log << "; linear solver: " << sim.newton().linear_solver().describe() << "\n";
   OutputResume resume;
   if (opt.restart && opt.append) resume = {opt.restart->frames, opt.restart->step};
+  // A new output must not keep an older run's checkpoint: restarting from it
+  // would mix that run's state with this run's frames.
+  if (!(opt.restart && opt.append)) std::filesystem::remove(dir + "/checkpoint.h5");
   RunOutput<dim> out(dir, scene, sim, opt.restart && opt.append ? &resume : nullptr);
   if (!(opt.restart && opt.append)) out.write_frame(sim);
   if (opt.restart)
@@ -161,7 +194,8 @@ RunSummary run_dim(const Scene& scene, const std::string& dir, const Teuchos::RC
     const StepReport r = sim.step();
     out.write_diagnostics(r);
     accumulate(s, r);
-    const int sig = guard ? global_signal(comm) : 0;
+    // A signal during the last step: the run is complete; finish normally.
+    const int sig = guard && n + 1 < n_steps ? global_signal(comm) : 0;
     const bool framed = (n + 1) % rc.output_every == 0 || n + 1 == n_steps || sig;
     if (framed) out.write_frame(sim);
     if (sig || (checkpoint_every > 0 && (n + 1) % checkpoint_every == 0 && n + 1 < n_steps)) checkpoint();
@@ -175,7 +209,11 @@ RunSummary run_dim(const Scene& scene, const std::string& dir, const Teuchos::RC
           << std::flush;
     }
     if (sig) {
-      out.close();
+      try {
+        out.close();
+      } catch (const std::exception& e) {
+        log << "warning: closing the output after the signal failed: " << e.what() << "\n";
+      }
       std::ostringstream msg;
       msg << (sig == SIGINT ? "SIGINT" : sig == SIGTERM ? "SIGTERM" : "signal") << " after step " << r.step
           << " (t = " << r.time << " s): frame and checkpoint written; continue with: bfemp restart " << dir;

@@ -363,3 +363,52 @@ TEST(Restart, SetOfAShapeChangingKeyIsRefused) {
   EXPECT_EQ(run_bfemp("restart " + dir + " " + end_time(c, 4) + " --set 'Linear Solver/type=KLU2'", dir + ".r3.log"), 0)
       << slurp(dir + ".r3.log");
 }
+
+TEST(Restart, ANewRunIntoTheDirectoryDropsTheOldCheckpoint) {
+  // Run A completes (checkpoint); run B into the same directory fails at step
+  // 1 before writing one: a restart must not continue A over B's files.
+  const Case c{"stale", squash, "", 1e-2, 2};
+  const std::string dir = fresh("stale");
+  ASSERT_EQ(run_bfemp("run " + squash + " " + end_time(c, 2) + " -o " + dir, dir + ".a.log"), 0);
+  ASSERT_TRUE(fs::exists(dir + "/checkpoint.h5"));
+  EXPECT_EQ(run_bfemp("run " + squash + " --set 'Newton/max iterations=1' -o " + dir, dir + ".b.log"), 3)
+      << slurp(dir + ".b.log");
+  EXPECT_FALSE(fs::exists(dir + "/checkpoint.h5"));
+  EXPECT_EQ(run_bfemp("restart " + dir, dir + ".r.log"), 2) << slurp(dir + ".r.log");
+}
+
+TEST(Restart, AChangedMeshFileIsRefused) {
+  const std::string dir = fresh("mesh_file"), work = root + "/mesh_file_scene";
+  fs::remove_all(work);
+  fs::create_directories(work);
+  fs::copy_file(src + "/tests/data/square_tri.msh", work + "/square.msh");
+  std::ofstream(work + "/scene.yaml") << R"(bfemp:
+  dimension: 2
+  gravity: [0.0, -9.81]
+  Time:
+    dt: 1.0e-2
+    end time: 2.5e-2
+  Output:
+    progress every: 0
+  Materials:
+    soft:
+      E: 1.0e5
+      nu: 0.3
+      density: 1000.0
+  FEM Bodies:
+    block:
+      material: soft
+      Mesh:
+        file: square.msh
+)";
+  ASSERT_EQ(run_bfemp("run " + work + "/scene.yaml -o " + dir, dir + ".log"), 0) << slurp(dir + ".log");
+  // Unchanged: the restart goes on.
+  EXPECT_EQ(run_bfemp("restart " + dir + " --set 'Time/end time=0.035'", dir + ".r1.log"), 0) << slurp(dir + ".r1.log");
+  std::string msh = slurp(work + "/square.msh");
+  const auto at = msh.find("\n1 1 0\n");  // the corner node (1, 1)
+  ASSERT_NE(at, std::string::npos);
+  msh.replace(at, 7, "\n1 1.01 0\n");
+  std::ofstream(work + "/square.msh") << msh;
+  EXPECT_EQ(run_bfemp("restart " + dir + " --set 'Time/end time=0.045'", dir + ".r2.log"), 2) << slurp(dir + ".r2.log");
+  EXPECT_NE(slurp(dir + ".r2.log").find("FEM mesh differs"), std::string::npos) << slurp(dir + ".r2.log");
+}

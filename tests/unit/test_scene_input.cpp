@@ -231,3 +231,14 @@ TEST(SceneInput, EmptyMaterialAndNewmarkAndStepCount) {
   expect_message(error_of(kScene, {"Output/progress every=-1"}), {"Output/progress every", ">= 0"});
   expect_message(error_of(kScene, {"Time/end time=1e300"}), {"Time/end time", "steps"});
 }
+
+TEST(SceneInput, DeeplyNestedFlowCollectionIsRefusedNotACrash) {
+  // 1e5 nested '[' would overflow the stack of a recursive scan.
+  const std::string yaml = "bfemp:\n  dimension: 2\n  gravity: " + std::string(100000, '[') + "\n";
+  try {
+    load_scene_from_string(yaml, ".");
+    FAIL() << "accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("nested deeper"), std::string::npos) << e.what();
+  }
+}
