@@ -82,15 +82,7 @@ int main(int argc, char** argv) {
         const bfemp::Checkpoint ck = bfemp::read_checkpoint(restart_dir + "/checkpoint.h5");
         const bfemp::Scene scene = bfemp::checkpoint_scene(ck, sets);
         opt.scene_source = ck.text("scene_source");
-        opt.overrides = sets;
-        {
-          std::istringstream prev(ck.text("overrides"));
-          std::vector<std::string> all;
-          for (std::string l; std::getline(prev, l);)
-            if (!l.empty()) all.push_back(l);
-          all.insert(all.end(), sets.begin(), sets.end());
-          opt.overrides = all;
-        }
+        opt.overrides = bfemp::checkpoint_overrides(ck, sets);
         opt.restart = &ck;
         opt.append = restart_output.empty() || same_dir(restart_output, restart_dir);
         if (root) log << bfemp::scene_summary(scene);

@@ -243,9 +243,13 @@ void check_restart_override(const std::string& assignment) {
 
 Scene checkpoint_scene(const Checkpoint& c, const std::vector<std::string>& extra) {
   for (const auto& e : extra) check_restart_override(e);
+  return load_scene_from_string(c.text("scene_source"), c.text("base_dir"), checkpoint_overrides(c, extra));
+}
+
+std::vector<std::string> checkpoint_overrides(const Checkpoint& c, const std::vector<std::string>& extra) {
   std::vector<std::string> overrides = split_lines(c.text("overrides"));
   overrides.insert(overrides.end(), extra.begin(), extra.end());
-  return load_scene_from_string(c.text("scene_source"), c.text("base_dir"), overrides);
+  return overrides;
 }
 
 RunSummary run_scene(const Scene& scene, const std::string& dir, const Teuchos::RCP<const Comm>& comm,

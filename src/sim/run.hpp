@@ -48,5 +48,8 @@ void check_restart_override(const std::string& assignment);
 // The scene a checkpoint was written from, with `extra` overrides applied
 // after its own (each checked by check_restart_override).
 Scene checkpoint_scene(const Checkpoint& c, const std::vector<std::string>& extra);
+// The checkpoint's own overrides followed by `extra` (what a restart applies
+// and stores in its next checkpoint).
+std::vector<std::string> checkpoint_overrides(const Checkpoint& c, const std::vector<std::string>& extra);
 
 }  // namespace bfemp

@@ -38,6 +38,30 @@ inline SimulationSetup<2> mpm_block_setup(double side, Vec<2> center, double dx,
   return mpm_rect_setup(side, side, center, dx, ppc, Vec<2>(lo, lo), Vec<2>(hi, hi), scheme, E, nu, rho);
 }
 
+// A neo-Hookean MPM box (E 1e6, nu 0.3, rho 1000, `ppc` particles per cell,
+// APIC) on a grid of spacing dx covering [lo, hi].
+inline SimulationSetup<3> cube_setup(Vec<3> center, Vec<3> size, double dx, Vec<3> lo, Vec<3> hi, int ppc = 8) {
+  SimulationSetup<3> s;
+  MaterialParams mp;
+  mp.model = MaterialModel::NeoHookean;
+  mp.lame = lame_from_young(1e6, 0.3);
+  mp.density = 1000.0;
+  s.materials.push_back(mp);
+  SamplingShape shape;
+  shape.kind = "box";
+  shape.center = {center(0), center(1), center(2)};
+  shape.size = {size(0), size(1), size(2)};
+  MpmSetup<3> m;
+  m.particles = sample_particles<3>(shape, dx, ppc, 1000.0, 0, 0);
+  m.grid = grid_covering<3>(lo, hi, dx);
+  m.scheme = TransferScheme::APIC;
+  m.body_names = {"cube"};
+  s.mpm = m;
+  s.linear_solver = *linear_solver_schema();
+  s.newton.eps_d = 1e-9;
+  return s;
+}
+
 // Mass-weighted mean of particle coordinate c.
 template <int dim>
 double particle_mean(const Particles<dim>& p, int c) {

@@ -16,28 +16,6 @@ namespace {
 
 constexpr double g = 10.0;
 
-SimulationSetup<3> cube_setup(Vec<3> center, Vec<3> size, double dx, Vec<3> lo, Vec<3> hi) {
-  SimulationSetup<3> s;
-  MaterialParams mp;
-  mp.model = MaterialModel::NeoHookean;
-  mp.lame = lame_from_young(1e6, 0.3);
-  mp.density = 1000.0;
-  s.materials.push_back(mp);
-  SamplingShape shape;
-  shape.kind = "box";
-  shape.center = {center(0), center(1), center(2)};
-  shape.size = {size(0), size(1), size(2)};
-  MpmSetup<3> m;
-  m.particles = sample_particles<3>(shape, dx, 8, 1000.0, 0, 0);
-  m.grid = grid_covering<3>(lo, hi, dx);
-  m.scheme = TransferScheme::APIC;
-  m.body_names = {"cube"};
-  s.mpm = m;
-  s.linear_solver = *linear_solver_schema();
-  s.newton.eps_d = 1e-9;
-  return s;
-}
-
 std::array<double, 3> momentum(const Particles<3>& p, double& M) {
   auto v = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), p.v);
   auto m = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), p.mass);

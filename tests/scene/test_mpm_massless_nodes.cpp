@@ -49,24 +49,8 @@ TEST(MpmMasslessNodes, NineParticlesPerCell2DFallsFreely) {
 }
 
 TEST(MpmMasslessNodes, TwentySevenParticlesPerCell3DFallsFreely) {
-  SimulationSetup<3> s;
-  MaterialParams mp;
-  mp.model = MaterialModel::NeoHookean;
-  mp.lame = lame_from_young(1e6, 0.3);
-  mp.density = 1000.0;
-  s.materials.push_back(mp);
-  SamplingShape shape;
-  shape.kind = "box";
-  shape.center = {0.5, 0.5, 0.5};
-  shape.size = {0.2, 0.2, 0.2};
-  MpmSetup<3> m;
-  m.particles = sample_particles<3>(shape, 0.1, 27, 1000.0, 0, 0);
-  m.grid = grid_covering<3>(Vec<3>(0.0, 0.0, 0.0), Vec<3>(1.0, 1.0, 1.0), 0.1);
-  m.scheme = TransferScheme::APIC;
-  m.body_names = {"cube"};
-  s.mpm = m;
-  s.linear_solver = *linear_solver_schema();
-  s.newton.eps_d = 1e-9;
+  auto s = cube_setup(Vec<3>(0.5, 0.5, 0.5), Vec<3>(0.2, 0.2, 0.2), 0.1, Vec<3>(0.0, 0.0, 0.0),
+                      Vec<3>(1.0, 1.0, 1.0), 27);
   s.dt = 0.01;
   s.gravity = {0.0, 0.0, -9.81};
   Simulation<3> sim(s, comm());
