@@ -66,67 +66,77 @@ void deformation_gradient(const DeformationStencils<dim, nv>& s, Kokkos::View<co
       });
 }
 
-// grad += scale * dPsi/dx and the Hessian blocks scale * V B^T (dP/dF)_+ B
-// summed into the rows of free DOFs of `A` (local column ids == DOF ids).
-// Couplings to prescribed DOFs move to the right-hand side:
-// rhs(free) -= H(free, prescribed) * dx_prescribed(prescribed).
-// `project` = false assembles the exact Hessian (finite-difference tests).
-template <int dim, int nv, class LocalMatrix>
-void deformation_assemble(const DeformationStencils<dim, nv>& s, Kokkos::View<const double*, MemSpace> x,
-                          double scale, Kokkos::View<double*, MemSpace> grad, const LocalMatrix& A,
-                          Kokkos::View<const int*, MemSpace> prescribed,
-                          Kokkos::View<const double*, MemSpace> dx_prescribed,
-                          Kokkos::View<double*, MemSpace> rhs, bool project = true) {
+// Local gradient and Hessian of stencil q, added into gl (nv*dim) and Hl
+// (nv*dim square), unscaled:
+//   gl(a dim + k)            += V sum_j P_kj g_aj
+//   Hl(a dim + k, b dim + l) += V sum_{j,m} g_aj (dP/dF)_{kj,lm} g_bm
+// with dP/dF projected onto the PSD cone when `project` (the exact tangent
+// otherwise, for derivative tests). Only the upper triangle of Hl (row <=
+// column) is written; symmetric_from_upper() completes it.
+template <int dim, int nv, class XView>
+KOKKOS_INLINE_FUNCTION void deformation_local_add(const DeformationStencils<dim, nv>& s, const XView& x, LO q,
+                                                  bool project, Eigen::Matrix<double, nv * dim, 1>& gl,
+                                                  SquareMat<nv * dim>& Hl) {
   constexpr int nd = nv * dim;
   constexpr int dd = dim * dim;
+  const MaterialParams& mp = s.materials(s.material(q));
+  const Mat<dim> F = stencil_F(s, x, q);
+  const double w = s.volume(q);
+  const Mat<dim> P = material_first_piola<dim>(mp, F);
+  const StressDerivative<dim> D =
+      project ? material_stress_derivative_psd<dim>(mp, F) : material_stress_derivative<dim>(mp, F);
+  double gq[nv][dim];
+  for (int a = 0; a < nv; ++a)
+    for (int j = 0; j < dim; ++j) gq[a][j] = s.g(q, a, j);
+  for (int a = 0; a < nv; ++a)
+    for (int k = 0; k < dim; ++k) {
+      double v = 0;
+      for (int j = 0; j < dim; ++j) v += P(k, j) * gq[a][j];
+      gl(a * dim + k) += w * v;
+    }
+  // DB(:, b dim + l) = w sum_m D(:, l + dim m) g_bm
+  Eigen::Matrix<double, dd, nd> DB;
+  for (int b = 0; b < nv; ++b)
+    for (int l = 0; l < dim; ++l) {
+      for (int r = 0; r < dd; ++r) {
+        double v = 0;
+        for (int m = 0; m < dim; ++m) v += D(r, l + dim * m) * gq[b][m];
+        DB(r, b * dim + l) = w * v;
+      }
+    }
+  for (int a = 0; a < nv; ++a)
+    for (int k = 0; k < dim; ++k) {
+      const int r = a * dim + k;
+      for (int c = r; c < nd; ++c) {
+        double h = 0;
+        for (int j = 0; j < dim; ++j) h += DB(k + dim * j, c) * gq[a][j];
+        Hl(r, c) += h;
+      }
+    }
+}
+
+template <int n>
+KOKKOS_INLINE_FUNCTION void symmetric_from_upper(SquareMat<n>& H) {
+  for (int r = 1; r < n; ++r)
+    for (int c = 0; c < r; ++c) H(r, c) = H(c, r);
+}
+
+// scale * (gradient, PSD-projected Hessian) of every stencil into the sink,
+// which eliminates prescribed DOFs (kernels/dof_sink.hpp). Stencils run in
+// parallel with atomic adds; see MpmElasticityTerm for the colored version.
+template <int dim, int nv, class Sink>
+void deformation_assemble(const DeformationStencils<dim, nv>& s, Kokkos::View<const double*, MemSpace> x,
+                          const Sink& sink, bool project = true) {
+  constexpr int nd = nv * dim;
   Kokkos::parallel_for(
       "deformation_assemble", Kokkos::RangePolicy<ExecSpace>(0, s.size()), KOKKOS_LAMBDA(const LO q) {
-        const MaterialParams& mp = s.materials(s.material(q));
-        const Mat<dim> F = stencil_F(s, x, q);
-        const double w = scale * s.volume(q);
-        const Mat<dim> P = material_first_piola<dim>(mp, F);
-        const StressDerivative<dim> D =
-            project ? material_stress_derivative_psd<dim>(mp, F) : material_stress_derivative<dim>(mp, F);
-        LO dof[nd];
-        for (int a = 0; a < nv; ++a)
-          for (int k = 0; k < dim; ++k) dof[a * dim + k] = s.nodes(q, a) * dim + k;
-        for (int a = 0; a < nv; ++a)
-          for (int k = 0; k < dim; ++k) {
-            double v = 0;
-            for (int j = 0; j < dim; ++j) v += P(k, j) * s.g(q, a, j);
-            Kokkos::atomic_add(&grad(dof[a * dim + k]), w * v);
-          }
-        // DB(:, b*dim + l) = sum_m D(:, l + dim m) g(b, m) = (dP/dF) dvec(F)/dx_{b,l}
-        Eigen::Matrix<double, dd, nd> DB;
-        for (int b = 0; b < nv; ++b)
-          for (int l = 0; l < dim; ++l) {
-            Eigen::Matrix<double, dd, 1> col = Eigen::Matrix<double, dd, 1>::Zero();
-            for (int m = 0; m < dim; ++m) col += D.col(l + dim * m) * s.g(q, b, m);
-            DB.col(b * dim + l) = col;
-          }
-        LO cols[nd];
-        double vals[nd];
-        for (int a = 0; a < nv; ++a)
-          for (int k = 0; k < dim; ++k) {
-            const int r = a * dim + k;
-            if (prescribed(dof[r])) continue;
-            int nc = 0;
-            double rhs_r = 0;
-            for (int c = 0; c < nd; ++c) {
-              double h = 0;
-              for (int j = 0; j < dim; ++j) h += DB(k + dim * j, c) * s.g(q, a, j);
-              h *= w;
-              if (prescribed(dof[c])) {
-                rhs_r -= h * dx_prescribed(dof[c]);
-              } else {
-                cols[nc] = dof[c];
-                vals[nc] = h;
-                ++nc;
-              }
-            }
-            A.sumIntoValues(dof[r], cols, nc, vals, false, true);
-            if (rhs_r != 0) Kokkos::atomic_add(&rhs(dof[r]), rhs_r);
-          }
+        Eigen::Matrix<double, nd, 1> gl = Eigen::Matrix<double, nd, 1>::Zero();
+        SquareMat<nd> Hl = SquareMat<nd>::Zero();
+        deformation_local_add<dim, nv>(s, x, q, project, gl, Hl);
+        symmetric_from_upper<nd>(Hl);
+        LO nodes[nv];
+        for (int a = 0; a < nv; ++a) nodes[a] = s.nodes(q, a);
+        sink.add_stencil(nodes, nv, gl, &Hl);
       });
 }
 

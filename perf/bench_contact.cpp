@@ -98,7 +98,7 @@ std::string bench(long n_particles, long n_facets) {
   Kokkos::View<int*, MemSpace> pres("pres", nn * 2);
   A->resumeFill();
   const auto lcl = A->getLocalMatrixDevice();
-  const double t_eval = best_time([&] { barrier->assemble(x, 1.0, grad, lcl, pres, dxp, rhs); });
+  const double t_eval = best_time([&] { barrier->assemble(x, make_sink<2>(lcl, 1.0, grad, rhs, pres, dxp)); });
   const double t_swept = best_time([&] { barrier->prepare_direction(x, dir); });
   const LO swept = barrier->candidate_pairs();
   double alpha = 0;

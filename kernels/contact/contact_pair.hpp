@@ -6,8 +6,8 @@
 //   x_q = sum_a w_qa x_{n(q,a)},   w the B-spline weights at x_q^n,
 // so a local gradient g and (PSD) Hessian H reach the system as W^T g and
 // W^T H W, where W maps the expanded DOFs (3^dim grid nodes, nv vertices) to
-// the local ones. Couplings to prescribed DOFs go to the right-hand side
-// (rhs(free) -= H(free, prescribed) dx_prescribed), as in deformation_assemble.
+// the local ones (scatter_pair hands them to the DOF space's sink, which
+// eliminates prescribed DOFs).
 #include <Kokkos_Core.hpp>
 #include <cmath>
 #include <type_traits>
@@ -118,47 +118,26 @@ KOKKOS_INLINE_FUNCTION void fill_pair_dofs(const ParticleStencils<dim>& ps, cons
   pd.nv = nv;
 }
 
-// Adds the pair's local gradient (grad += W^T g) and, when `A` is given, its
-// local Hessian W^T H W on free rows; prescribed columns go to rhs.
-template <int dim, int L, class LocalMatrix>
+// The pair's local gradient and (when H is given) Hessian, expanded through
+// W, into the sink: W^T g and the blocks w_e w_f H(block e, block f), where a
+// grid node's block is the particle's and a vertex's its own. The sink scales
+// them and eliminates prescribed DOFs.
+template <int dim, int L, class Sink>
 KOKKOS_INLINE_FUNCTION void scatter_pair(const PairDofs<dim>& pd, const Eigen::Matrix<double, L, 1>& g,
-                                         const SquareMat<L>* H, Kokkos::View<double*, MemSpace> grad,
-                                         const LocalMatrix* A, const Kokkos::View<const int*, MemSpace>& prescribed,
-                                         const Kokkos::View<const double*, MemSpace>& dx_prescribed,
-                                         const Kokkos::View<double*, MemSpace>& rhs) {
+                                         const SquareMat<L>* H, const Sink& sink) {
   constexpr int ns = PairDofs<dim>::ns;
-  constexpr int maxn = (ns + dim) * dim;
   const int ne = pd.expanded_nodes();
-  // Local block of expanded node e and its weight (grid nodes: the particle
-  // block scaled by w; vertices: their own block).
   auto block = [&](int e) { return e < ns ? 0 : e - ns + 1; };
   auto weight = [&](int e) { return e < ns ? pd.w[e] : 1.0; };
   for (int e = 0; e < ne; ++e)
-    for (int c = 0; c < dim; ++c) Kokkos::atomic_add(&grad(pd.node[e] * dim + c), weight(e) * g(block(e) * dim + c));
-  if (!A) return;
-  LO cols[maxn];
-  double vals[maxn];
+    for (int c = 0; c < dim; ++c) sink.add_gradient(pd.node[e], c, weight(e) * g(block(e) * dim + c));
+  if (!H || !sink.has_matrix()) return;
   for (int e = 0; e < ne; ++e)
-    for (int c = 0; c < dim; ++c) {
-      const LO row = pd.node[e] * dim + c;
-      if (prescribed(row)) continue;
-      const int lr = block(e) * dim + c;
-      int nc = 0;
-      double rhs_r = 0;
-      for (int f = 0; f < ne; ++f)
-        for (int k = 0; k < dim; ++k) {
-          const LO col = pd.node[f] * dim + k;
-          const double h = weight(e) * weight(f) * (*H)(lr, block(f) * dim + k);
-          if (prescribed(col)) {
-            rhs_r -= h * dx_prescribed(col);
-          } else {
-            cols[nc] = col;
-            vals[nc] = h;
-            ++nc;
-          }
-        }
-      A->sumIntoValues(row, cols, nc, vals, false, true);
-      if (rhs_r != 0) Kokkos::atomic_add(&rhs(row), rhs_r);
+    for (int f = 0; f < ne; ++f) {
+      const double wef = weight(e) * weight(f);
+      if (wef == 0.0) continue;  // a B-spline weight of 0 adds nothing
+      const int be = block(e) * dim, bf = block(f) * dim;
+      sink.add_block(pd.node[e], pd.node[f], [&](int i, int j) { return wef * (*H)(be + i, bf + j); });
     }
 }
 

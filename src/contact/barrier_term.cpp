@@ -55,11 +55,29 @@ void BarrierTerm<dim>::begin_step(const ParticleStencils<dim>& ps, ConstDofView 
     dq_ = Kokkos::View<double*, MemSpace>("contact_dq", n);
   }
   find_pairs(x, ConstDofView());
-  auto pairs = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), pairs_);
+  // Signature of the couplings: each pair with its particle's stencil base
+  // node (the stencil's other nodes follow from it while the MPM cells are
+  // unchanged; when they change, the MPM term's version forces a rebuild).
+  Kokkos::View<long long* [2], MemSpace> sig_dev("contact_graph_signature", n_pairs_);
+  {
+    const auto pairs = pairs_;
+    const auto nodes = ps.nodes;
+    const long long np = prims_.size();
+    Kokkos::parallel_for(
+        "contact_graph_signature", Kokkos::RangePolicy<ExecSpace>(0, n_pairs_), KOKKOS_LAMBDA(const LO k) {
+          sig_dev(k, 0) = pairs(k, 0) * np + pairs(k, 1);
+          sig_dev(k, 1) = nodes(pairs(k, 0), 0);
+        });
+  }
+  auto sig_h = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), sig_dev);
+  std::vector<std::pair<long long, long long>> sig(n_pairs_);
+  for (LO k = 0; k < n_pairs_; ++k) sig[k] = {sig_h(k, 0), sig_h(k, 1)};
+  std::sort(sig.begin(), sig.end());
+  if (sig == signature_) return;  // the graph already holds these pairs
+  signature_ = std::move(sig);
+  ++version_;
   graph_keys_.clear();
-  const long long np = prims_.size();
-  for (LO k = 0; k < n_pairs_; ++k) graph_keys_.push_back(pairs(k, 0) * np + pairs(k, 1));
-  std::sort(graph_keys_.begin(), graph_keys_.end());
+  for (const auto& e : signature_) graph_keys_.push_back(e.first);
   graph_keys_dev_ = Kokkos::View<long long*, MemSpace>("contact_graph_keys", graph_keys_.size());
   Kokkos::deep_copy(graph_keys_dev_, Kokkos::View<const long long*, Kokkos::HostSpace>(graph_keys_.data(), graph_keys_.size()));
 }
@@ -105,6 +123,7 @@ bool BarrierTerm<dim>::update(ConstDofView x) const {
   graph_keys_.erase(std::unique(graph_keys_.begin(), graph_keys_.end()), graph_keys_.end());
   graph_keys_dev_ = Kokkos::View<long long*, MemSpace>("contact_graph_keys", graph_keys_.size());
   Kokkos::deep_copy(graph_keys_dev_, Kokkos::View<const long long*, Kokkos::HostSpace>(graph_keys_.data(), graph_keys_.size()));
+  ++version_;
   return true;
 }
 
@@ -183,27 +202,24 @@ void BarrierTerm<dim>::for_each_pair(ConstDofView x, const Body& body) const {
 template <int dim>
 void BarrierTerm<dim>::gradient(ConstDofView x, double scale, DofView grad) const {
   if (n_pairs_ == 0) return;
-  const MaskView none;
-  const ConstDofView dnone;
-  const DofView rnone;
+  Sink<dim> sink;  // gradient only
+  sink.grad = grad;
+  sink.scale = scale;
   for_each_pair(x, [=](LO, const PairDofs<dim>& pd, const auto& g, const auto&) {
     constexpr int L = std::decay_t<decltype(g)>::RowsAtCompileTime;
-    const Eigen::Matrix<double, L, 1> gs = scale * g;
-    scatter_pair<dim, L, LocalMatrix>(pd, gs, nullptr, grad, nullptr, none, dnone, rnone);
+    scatter_pair<dim, L>(pd, g, static_cast<const SquareMat<L>*>(nullptr), sink);
   });
 }
 
 template <int dim>
-void BarrierTerm<dim>::assemble(ConstDofView x, double scale, DofView grad, const LocalMatrix& A,
-                                MaskView prescribed, ConstDofView dx_prescribed, DofView rhs) const {
+void BarrierTerm<dim>::assemble(ConstDofView x, const Sink<dim>& sink) const {
   if (n_pairs_ == 0) return;
   const bool project = project_;
   for_each_pair(x, [=](LO, const PairDofs<dim>& pd, const auto& g, const auto& H) {
     constexpr int L = std::decay_t<decltype(g)>::RowsAtCompileTime;
-    const Eigen::Matrix<double, L, 1> gs = scale * g;
-    SquareMat<L> Hs = scale * H;
-    if (project) project_psd<L>(Hs);
-    scatter_pair<dim, L, LocalMatrix>(pd, gs, &Hs, grad, &A, prescribed, dx_prescribed, rhs);
+    SquareMat<L> Hp = H;
+    if (project) project_psd<L>(Hp);
+    scatter_pair<dim, L>(pd, g, &Hp, sink);
   });
 }
 

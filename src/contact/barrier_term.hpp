@@ -27,10 +27,12 @@ class BarrierTerm : public EnergyTerm<dim> {
   void begin_step(const ParticleStencils<dim>& ps, ConstDofView x);
 
   void add_couplings(std::vector<long long>& keys, LO n_nodes) const override;
+  // Changes when this step's pairs (with their particles' stencils) differ
+  // from those the graph was built with, or update() grew the graph.
+  std::uint64_t couplings_version() const override { return version_; }
   double energy(ConstDofView x) const override;
   void gradient(ConstDofView x, double scale, DofView grad) const override;
-  void assemble(ConstDofView x, double scale, DofView grad, const LocalMatrix& A, MaskView prescribed,
-                ConstDofView dx_prescribed, DofView rhs) const override;
+  void assemble(ConstDofView x, const Sink<dim>& sink) const override;
   double max_step(ConstDofView x, ConstDofView p) const override;
   bool update(ConstDofView x) const override;
   void prepare_direction(ConstDofView x, ConstDofView p) const override;
@@ -75,6 +77,8 @@ class BarrierTerm : public EnergyTerm<dim> {
   mutable LO n_pairs_ = 0;
   mutable std::vector<long long> graph_keys_;  // q * n_prims + j, sorted
   mutable Kokkos::View<long long*, MemSpace> graph_keys_dev_;
+  std::vector<std::pair<long long, long long>> signature_;  // (pair key, stencil base) at begin_step
+  mutable std::uint64_t version_ = 0;
   mutable double ccd_min_;
   mutable Timings timings_;
 };

@@ -194,23 +194,22 @@ void FrictionTerm<dim>::gradient(ConstDofView x, double scale, DofView grad) con
   const auto c = c_;
   const auto ml = ml_;
   const double s = s_, eh = eh_;
-  const MaskView none;
-  const ConstDofView dnone;
-  const DofView rnone;
+  Sink<dim> sink;  // gradient only
+  sink.grad = grad;
+  sink.scale = scale;
   for_each_pair(x, [=](LO k, LO, const PairDofs<dim>& pd, const auto& u, const auto& T) {
     dispatch_nv<dim>(pd.nv, [&](auto NV) {
       constexpr int nv = decltype(NV)::value;
       constexpr int L = (1 + nv) * dim;
       Eigen::Matrix<double, L, 1> g;
-      friction_local<dim, nv>(c, k, scale * ml(k), s, eh, u, T, g, static_cast<SquareMat<L>*>(nullptr));
-      scatter_pair<dim, L, LocalMatrix>(pd, g, nullptr, grad, nullptr, none, dnone, rnone);
+      friction_local<dim, nv>(c, k, ml(k), s, eh, u, T, g, static_cast<SquareMat<L>*>(nullptr));
+      scatter_pair<dim, L>(pd, g, static_cast<const SquareMat<L>*>(nullptr), sink);
     });
   });
 }
 
 template <int dim>
-void FrictionTerm<dim>::assemble(ConstDofView x, double scale, DofView grad, const LocalMatrix& A,
-                                 MaskView prescribed, ConstDofView dx_prescribed, DofView rhs) const {
+void FrictionTerm<dim>::assemble(ConstDofView x, const Sink<dim>& sink) const {
   if (n_ == 0) return;
   const auto c = c_;
   const auto ml = ml_;
@@ -221,8 +220,8 @@ void FrictionTerm<dim>::assemble(ConstDofView x, double scale, DofView grad, con
       constexpr int L = (1 + nv) * dim;
       Eigen::Matrix<double, L, 1> g;
       SquareMat<L> H;
-      friction_local<dim, nv>(c, k, scale * ml(k), s, eh, u, T, g, &H);
-      scatter_pair<dim, L, LocalMatrix>(pd, g, &H, grad, &A, prescribed, dx_prescribed, rhs);
+      friction_local<dim, nv>(c, k, ml(k), s, eh, u, T, g, &H);
+      scatter_pair<dim, L>(pd, g, &H, sink);
     });
   });
 }

@@ -34,8 +34,7 @@ class FrictionTerm : public EnergyTerm<dim> {
   void add_couplings(std::vector<long long>& keys, LO n_nodes) const override;
   double energy(ConstDofView x) const override;
   void gradient(ConstDofView x, double scale, DofView grad) const override;
-  void assemble(ConstDofView x, double scale, DofView grad, const LocalMatrix& A, MaskView prescribed,
-                ConstDofView dx_prescribed, DofView rhs) const override;
+  void assemble(ConstDofView x, const Sink<dim>& sink) const override;
   double max_step(ConstDofView, ConstDofView) const override { return std::numeric_limits<double>::infinity(); }
   // Friction force on the particles (-dD/dx_q), added into f.
   void add_particle_forces(ConstDofView x, DofView f) const;

@@ -20,6 +20,39 @@ void MpmElasticityTerm<dim>::add_couplings(std::vector<long long>& keys, LO n_no
 }
 
 template <int dim>
+void MpmElasticityTerm<dim>::assemble(ConstDofView x, const Sink<dim>& sink) const {
+  constexpr int ns = bspline_stencil_size<dim>;
+  constexpr int nd = ns * dim;
+  constexpr int nc = ParticleCells<dim>::n_colors;
+  const auto s = this->stencils();
+  const bool project = this->projection();
+  const auto cells = cells_.cells;
+  const auto start = cells_.start;
+  const auto count = cells_.count;
+  const auto order = cells_.order;
+  if (cells_.order.extent(0) != static_cast<std::size_t>(s.size()))
+    throw std::logic_error("MpmElasticityTerm::assemble: particles not binned into cells for these stencils");
+  Sink<dim> plain = sink;
+  plain.atomic = false;  // the cells of one color share no node
+  for (int c = 0; c < nc; ++c) {
+    const LO c0 = cells_.color_start(c), c1 = cells_.color_start(c + 1);
+    if (c1 == c0) continue;
+    Kokkos::parallel_for(
+        "mpm_assemble_cells", Kokkos::RangePolicy<ExecSpace>(c0, c1), KOKKOS_LAMBDA(const LO k) {
+          const LO n = cells(k);
+          Eigen::Matrix<double, nd, 1> gl = Eigen::Matrix<double, nd, 1>::Zero();
+          SquareMat<nd> Hl = SquareMat<nd>::Zero();
+          const LO first = start(n), last = start(n) + count(n);
+          for (LO i = first; i < last; ++i) deformation_local_add<dim, ns>(s, x, order(i), project, gl, Hl);
+          symmetric_from_upper<nd>(Hl);
+          LO nodes[ns];
+          for (int a = 0; a < ns; ++a) nodes[a] = s.nodes(order(first), a);
+          plain.add_stencil(nodes, ns, gl, &Hl);
+        });
+  }
+}
+
+template <int dim>
 MpmBodies<dim>::MpmBodies(MpmSetup<dim> setup, Kokkos::View<MaterialParams*, MemSpace> materials)
     : setup_(std::move(setup)), materials_(materials) {
   const std::size_t np = setup_.particles.size();
@@ -87,7 +120,9 @@ LO MpmBodies<dim>::begin_step(LO first, long step) {
   Kokkos::Experimental::contribute(mass_, mass_scatter_);  // no-op for atomic, kept for portability
   Kokkos::Experimental::contribute(momentum_, momentum_scatter_);
   mpm_stencils(grid, p, system_node_, stencils_);
+  bin_particles(grid, p, cells_);
   term_->set_stencils(stencils_);
+  term_->set_cells(cells_);
   return active_;
 }
 

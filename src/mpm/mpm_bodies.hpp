@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "kernels/mpm_transfer.hpp"
+#include "mpm/particle_cells.hpp"
 #include "solver/energy_term.hpp"
 
 namespace bfemp {
@@ -27,11 +28,27 @@ struct MpmSetup {
 
 // MPM elasticity: deformation stencils of the particles; the graph couplings
 // come from one particle per distinct stencil (particles in a cell share it).
+// Assembly is by cell and color (mpm/particle_cells.hpp): the particles of a
+// cell sum their local gradient and Hessian in registers, the cell adds them
+// once, and the cells of one color run in parallel without atomics. The
+// couplings change only when the set of occupied cells does.
 template <int dim>
 class MpmElasticityTerm : public DeformationTerm<dim, bspline_stencil_size<dim>> {
  public:
   using DeformationTerm<dim, bspline_stencil_size<dim>>::DeformationTerm;
   void add_couplings(std::vector<long long>& keys, LO n_nodes) const override;
+  std::uint64_t couplings_version() const override { return cells_.version; }
+  void assemble(ConstDofView x, const Sink<dim>& sink) const override;
+  // The stencil-by-stencil assembly with atomics (the generic path; tests
+  // compare the two).
+  void assemble_per_particle(ConstDofView x, const Sink<dim>& sink) const {
+    DeformationTerm<dim, bspline_stencil_size<dim>>::assemble(x, sink);
+  }
+  void set_cells(const ParticleCells<dim>& c) { cells_ = c; }
+  const ParticleCells<dim>& cells() const { return cells_; }
+
+ private:
+  ParticleCells<dim> cells_;
 };
 
 template <int dim>
@@ -84,6 +101,7 @@ class MpmBodies {
                                                     Kokkos::Experimental::ScatterAtomic>;
   Scatter mass_scatter_, momentum_scatter_;
   DeformationStencils<dim, ns> stencils_;
+  ParticleCells<dim> cells_;
   std::unique_ptr<MpmElasticityTerm<dim>> term_;
   LO first_ = 0, active_ = 0;
   int extensions_ = 0;

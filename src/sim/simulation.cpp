@@ -41,7 +41,7 @@ Simulation<dim>::Simulation(SimulationSetup<dim> setup, const Teuchos::RCP<const
     throw std::invalid_argument("scene has " + std::to_string(setup_.level_sets.size()) +
                                 " level sets; expected at most " + std::to_string(kMaxLevelSets));
   for (const auto& ls : setup_.level_sets) level_sets_.sets[level_sets_.count++] = ls;
-  if (!mpm_) newton_->set_system(mesh_.num_nodes(), {elasticity_.get()}, true);
+  if (!mpm_) newton_->set_system(mesh_.num_nodes(), {elasticity_.get()});
   const std::size_t n = static_cast<std::size_t>(mesh_.num_nodes()) * dim;
   x_ = View1("fem_x", n);
   v_ = View1("fem_v", n);
@@ -202,6 +202,7 @@ StepReport Simulation<dim>::step() {
   Kokkos::deep_copy(Kokkos::subview(mass, fem), mass_);
   Kokkos::deep_copy(Kokkos::subview(pres, fem), prescribed_);
   std::vector<const EnergyTerm<dim>*> terms;
+  bool graph_rebuilt = false;
   if (nF > 0) terms.push_back(elasticity_.get());
   if (mpm_) {
     auto grid_part = std::make_pair(nfd, nd);
@@ -216,7 +217,7 @@ StepReport Simulation<dim>::step() {
       terms.push_back(contact_->barrier());
       if (contact_->has_friction()) terms.push_back(contact_->friction());
     }
-    newton_->set_system(nF + nA, terms, true);
+    graph_rebuilt = newton_->set_system(nF + nA, terms);
     // Grid a^n = g - M^-1 grad Psi(x^n) (the Newmark predictor needs it).
     auto work = System::head(S.work, nd);
     Kokkos::deep_copy(work, 0.0);
@@ -255,6 +256,7 @@ StepReport Simulation<dim>::step() {
     msg << "step " << step_ + 1 << " (t = " << t1 << " s): " << e.what();
     throw SolverError(msg.str());
   }
+  if (graph_rebuilt) ++ns.graph_builds;
   typename Contact<dim>::Report contact_report;
   if (contact_) contact_report = contact_->report(x, nF);
 
@@ -309,6 +311,8 @@ NewtonStats Simulation<dim>::minimize_with_friction(const IncrementalPotential& 
     total.solve_s += st.solve_s;
     total.line_search_s += st.line_search_s;
     total.min_step = std::min(total.min_step, st.min_step);
+    total.graph_builds += st.graph_builds;
+    total.symbolic_factorizations += st.symbolic_factorizations;
     if (iterations > 1 && st.iterations == 1) break;  // converged at the lagged update
     const LO relagged = contact_->update_friction(x, x_ref, s, ip.dt);
     if (lagged == 0 && relagged == 0) break;  // no friction pairs before or after

@@ -1,12 +1,17 @@
 #pragma once
 // One term of the incremental potential's elastic part (FEM elements, MPM
-// particles; later barrier and friction), seen by the Newton solver through
+// particles, barrier and friction contact), seen by the Newton solver through
 // value, gradient, PSD Hessian assembly, line-search step bound and the node
 // couplings its Hessian needs in the system graph.
+// A term computes local quantities only: its assemble() hands each stencil's
+// (nodes, gradient, Hessian) to the DOF space's sink (kernels/dof_sink.hpp),
+// which applies the constraints and adds into the matrix.
+#include <cstdint>
 #include <string>
 #include <vector>
 
 #include "kernels/deformation_energy.hpp"
+#include "kernels/dof_sink.hpp"
 #include "solver/tpetra_types.hpp"
 
 namespace bfemp {
@@ -15,6 +20,24 @@ using LocalMatrix = Matrix::local_matrix_device_type;
 using DofView = Kokkos::View<double*, MemSpace>;
 using ConstDofView = Kokkos::View<const double*, MemSpace>;
 using MaskView = Kokkos::View<const int*, MemSpace>;
+template <int dim>
+using Sink = DofSink<dim, LocalMatrix>;
+
+// A sink on a matrix the caller built (tests, benchmarks); the simulation's
+// comes from its DofSpace.
+template <int dim>
+Sink<dim> make_sink(const LocalMatrix& A, double scale, Kokkos::View<double*, MemSpace> grad,
+                    Kokkos::View<double*, MemSpace> rhs, Kokkos::View<const int*, MemSpace> prescribed,
+                    Kokkos::View<const double*, MemSpace> dx_prescribed) {
+  Sink<dim> s;
+  s.A = A;
+  s.grad = grad;
+  s.rhs = rhs;
+  s.prescribed = prescribed;
+  s.dx_prescribed = dx_prescribed;
+  s.scale = scale;
+  return s;
+}
 
 template <int dim>
 class EnergyTerm {
@@ -23,13 +46,15 @@ class EnergyTerm {
   virtual std::string name() const = 0;
   // Appends node pairs a * n_nodes + b (both orders) the Hessian may touch.
   virtual void add_couplings(std::vector<long long>& keys, LO n_nodes) const = 0;
+  // Changes whenever the couplings add_couplings would give change (the DOF
+  // space rebuilds its graph only then).
+  virtual std::uint64_t couplings_version() const { return 0; }
   virtual double energy(ConstDofView x) const = 0;
   // grad += scale * dE/dx
   virtual void gradient(ConstDofView x, double scale, DofView grad) const = 0;
-  // grad += scale * dE/dx; A += scale * PSD Hessian on free rows; couplings to
-  // prescribed DOFs go to rhs (see deformation_assemble).
-  virtual void assemble(ConstDofView x, double scale, DofView grad, const LocalMatrix& A, MaskView prescribed,
-                        ConstDofView dx_prescribed, DofView rhs) const = 0;
+  // Each stencil's local gradient and PSD Hessian into the sink (which scales
+  // them and applies the constraints).
+  virtual void assemble(ConstDofView x, const Sink<dim>& sink) const = 0;
   // Largest step along p keeping the term defined (inf if unbounded).
   virtual double max_step(ConstDofView x, ConstDofView p) const = 0;
   // Called at every Newton iterate x before its assembly (contact: the pairs
@@ -61,12 +86,12 @@ class DeformationTerm : public EnergyTerm<dim> {
   void gradient(ConstDofView x, double scale, DofView grad) const override {
     deformation_gradient(s_, x, scale, grad);
   }
-  void assemble(ConstDofView x, double scale, DofView grad, const LocalMatrix& A, MaskView prescribed,
-                ConstDofView dx_prescribed, DofView rhs) const override {
-    deformation_assemble(s_, x, scale, grad, A, prescribed, dx_prescribed, rhs, project_);
+  void assemble(ConstDofView x, const Sink<dim>& sink) const override {
+    deformation_assemble(s_, x, sink, project_);
   }
   // false: assemble the exact (unprojected) Hessian, for derivative tests.
   void set_projection(bool project) { project_ = project; }
+  bool projection() const { return project_; }
   double max_step(ConstDofView x, ConstDofView p) const override { return deformation_max_step(s_, x, p); }
 
  private:

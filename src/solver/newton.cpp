@@ -7,7 +7,6 @@
 #include <limits>
 #include <sstream>
 
-#include "solver/dof_graph.hpp"
 #include "solver/solver_error.hpp"
 
 namespace bfemp {
@@ -20,46 +19,35 @@ struct NewtonSolver<dim>::Impl {
   Teuchos::RCP<const Comm> comm;
   NewtonParams params;
   LinearSolver solver;
-  std::vector<const EnergyTerm<dim>*> terms;
-  LO n_nodes = -1;
-  Teuchos::RCP<const Map> map;
-  Teuchos::RCP<Matrix> A;
+  DofSpace<dim> dofs;
   Teuchos::RCP<Vector> b, p;
   View1 grad, rhs, dx_prescribed, dir, trial;
-  Teuchos::RCP<Teuchos::ParameterList> fill_params;
-  double graph_build_s = 0;
-  SlipConstraints<dim> slip;  // normal-velocity constraints (slip level sets)
+  long symbolic_factorizations = 0;
 
   Impl(const Teuchos::RCP<const Comm>& c, const Teuchos::ParameterList& ls, NewtonParams np)
-      : comm(c), params(np), solver(ls, c) {
+      : comm(c), params(np), solver(ls, c), dofs(c) {
     if (comm->getSize() > 1)
       throw std::invalid_argument(
           "the Newton solver runs on 1 MPI rank in this version (the distributed "
           "assembly comes with the MPI issue); run without mpirun or with -np 1");
-    fill_params = Teuchos::parameterList();
-    fill_params->set("No Nonlocal Changes", true);
   }
 
-  void rebuild(LO n) {
-    Kokkos::Timer timer;
-    const std::size_t ndof = static_cast<std::size_t>(n) * dim;
-    if (n != n_nodes) {
-      map = Teuchos::rcp(new Map(static_cast<Tpetra::global_size_t>(ndof), 0, comm));
-      b = Teuchos::rcp(new Vector(map));
-      p = Teuchos::rcp(new Vector(map));
-      grad = View1("newton_grad", ndof);
-      rhs = View1("newton_rhs", ndof);
-      dx_prescribed = View1("newton_dx_prescribed", ndof);
-      dir = View1("newton_dir", ndof);
-      trial = View1("newton_trial", ndof);
-      n_nodes = n;
-    }
-    std::vector<long long> keys;
-    for (const auto* t : terms) t->add_couplings(keys, n);
-    A = Teuchos::rcp(new Matrix(build_dof_graph<dim>(keys, n, map)));
-    A->fillComplete();
-    solver.set_matrix(A);
-    graph_build_s = timer.seconds();
+  // Vectors for a new node count (grow only when the count changes).
+  void resize_vectors() {
+    const std::size_t ndof = dofs.num_dofs();
+    if (grad.extent(0) == ndof && !b.is_null() && b->getMap() == dofs.map()) return;
+    b = Teuchos::rcp(new Vector(dofs.map()));
+    p = Teuchos::rcp(new Vector(dofs.map()));
+    grad = View1("newton_grad", ndof);
+    rhs = View1("newton_rhs", ndof);
+    dx_prescribed = View1("newton_dx_prescribed", ndof);
+    dir = View1("newton_dir", ndof);
+    trial = View1("newton_trial", ndof);
+  }
+
+  void matrix_changed() {
+    solver.set_matrix(dofs.matrix());
+    resize_vectors();
   }
 
   // Gradient, projected Hessian and right-hand side at x.
@@ -69,27 +57,22 @@ struct NewtonSolver<dim>::Impl {
     auto dxp = dx_prescribed;
     Kokkos::deep_copy(g, 0.0);
     Kokkos::deep_copy(r, 0.0);
-    A->resumeFill();
-    A->setAllToScalar(0.0);
-    auto lcl = A->getLocalMatrixDevice();
-    for (const auto* t : terms) t->assemble(x, ip.h, g, lcl, ip.prescribed, dxp, r);
+    dofs.begin_assembly();
+    const Sink<dim> sink = dofs.sink(ip.h, g, r, ip.prescribed, dxp);
+    for (const auto* t : dofs.terms()) t->assemble(x, sink);
+    auto lcl = sink.A;
     auto mass = ip.mass;
     auto xhat = ip.x_hat;
     auto pres = ip.prescribed;
     Kokkos::parallel_for(
         "newton_inertia", Kokkos::RangePolicy<ExecSpace>(0, g.extent(0)), KOKKOS_LAMBDA(const LO i) {
           g(i) += mass(i) * (x(i) - xhat(i));
-          double diag = mass(i);
-          if (pres(i)) {
-            diag = 1.0;
-            r(i) = dxp(i);
-          } else {
-            r(i) -= g(i);
-          }
+          if (pres(i)) return;  // the DOF space writes the constraint row
+          r(i) -= g(i);
+          const double diag = mass(i);
           lcl.sumIntoValues(i, &i, 1, &diag, false, true);
         });
-    slip.transform_system(lcl, r);  // A <- P A P + Q, r <- P (r - A w) + w on slip nodes
-    A->fillComplete(fill_params);
+    dofs.end_assembly(pres, dxp, r);  // prescribed rows, slip transform
   }
 };
 
@@ -102,15 +85,20 @@ template <int dim>
 NewtonSolver<dim>::~NewtonSolver() = default;
 
 template <int dim>
-void NewtonSolver<dim>::set_system(LO n_nodes, std::vector<const EnergyTerm<dim>*> terms,
-                                   bool structure_changed) {
-  impl_->terms = std::move(terms);
-  if (structure_changed || n_nodes != impl_->n_nodes || impl_->A.is_null()) impl_->rebuild(n_nodes);
+bool NewtonSolver<dim>::set_system(LO n_nodes, std::vector<const EnergyTerm<dim>*> terms) {
+  const bool rebuilt = impl_->dofs.set_structure(n_nodes, terms);
+  if (rebuilt) impl_->matrix_changed();
+  return rebuilt;
 }
 
 template <int dim>
 SlipConstraints<dim>& NewtonSolver<dim>::slip_constraints() {
-  return impl_->slip;
+  return impl_->dofs.slip();
+}
+
+template <int dim>
+const DofSpace<dim>& NewtonSolver<dim>::dof_space() const {
+  return impl_->dofs;
 }
 
 template <int dim>
@@ -120,24 +108,24 @@ const LinearSolver& NewtonSolver<dim>::linear_solver() const {
 
 template <int dim>
 Teuchos::RCP<const Map> NewtonSolver<dim>::dof_map() const {
-  return impl_->map;
+  return impl_->dofs.map();
 }
 
 template <int dim>
 double NewtonSolver<dim>::last_graph_build_s() const {
-  return impl_->graph_build_s;
+  return impl_->dofs.last_graph_build_s();
 }
 
 template <int dim>
 double NewtonSolver<dim>::potential(CView1 x) const {
   double e = 0;
-  for (const auto* t : impl_->terms) e += t->energy(x);
+  for (const auto* t : impl_->dofs.terms()) e += t->energy(x);
   return e;
 }
 
 template <int dim>
 void NewtonSolver<dim>::potential_gradient(CView1 x, double scale, View1 grad) const {
-  for (const auto* t : impl_->terms) t->gradient(x, scale, grad);
+  for (const auto* t : impl_->dofs.terms()) t->gradient(x, scale, grad);
 }
 
 template <int dim>
@@ -177,12 +165,16 @@ NewtonStats NewtonSolver<dim>::minimize(const IncrementalPotential& ip, View1 x)
           acc = std::fmax(acc, std::fabs(dxp(i)));
         },
         Kokkos::Max<double>(pres_left));
-    pres_left = std::max(pres_left, m.slip.update_offsets(x));  // remaining slip offsets
+    pres_left = std::max(pres_left, m.dofs.slip().update_offsets(x));  // remaining slip offsets
 
     timer.reset();
     bool grow = false;
-    for (const auto* t : m.terms) grow = t->update(x) || grow;
-    if (grow) m.rebuild(m.n_nodes);
+    for (const auto* t : m.dofs.terms()) grow = t->update(x) || grow;
+    if (grow) {
+      m.dofs.rebuild();
+      m.matrix_changed();
+      ++st.graph_builds;
+    }
     m.assemble(ip, x);
     Kokkos::fence();
     st.assembly_s += timer.seconds();
@@ -195,6 +187,7 @@ NewtonStats NewtonSolver<dim>::minimize(const IncrementalPotential& ip, View1 x)
     m.p->putScalar(0.0);
     const LinearSolveStats ls = m.solver.solve(*m.b, *m.p);
     st.linear_iterations += ls.iterations;
+    if (ls.refactored) ++st.symbolic_factorizations;
     {
       auto pv = Kokkos::subview(m.p->getLocalViewDevice(Tpetra::Access::ReadOnly), Kokkos::ALL(), 0);
       Kokkos::deep_copy(dir, pv);
@@ -210,8 +203,8 @@ NewtonStats NewtonSolver<dim>::minimize(const IncrementalPotential& ip, View1 x)
           acc = std::fmax(acc, std::fabs(dir(i)));
         },
         Kokkos::Max<double>(p_inf));
-    if (m.slip.count() > 0) {  // exact normal part at slip nodes, as for prescribed DOFs
-      m.slip.fix_direction(dir);
+    if (m.dofs.slip().count() > 0) {  // exact normal part at slip nodes, as for prescribed DOFs
+      m.dofs.slip().fix_direction(dir);
       Kokkos::parallel_reduce(
           "newton_dir_norm_slip", Kokkos::RangePolicy<ExecSpace>(0, x.extent(0)),
           KOKKOS_LAMBDA(const LO i, double& acc) { acc = std::fmax(acc, std::fabs(dir(i))); },
@@ -220,9 +213,9 @@ NewtonStats NewtonSolver<dim>::minimize(const IncrementalPotential& ip, View1 x)
     if (!std::isfinite(p_inf))
       throw SolverError("Newton direction is not finite (linear solve produced NaN/Inf)");
 
-    for (const auto* t : m.terms) t->prepare_direction(x, dir);
+    for (const auto* t : m.dofs.terms()) t->prepare_direction(x, dir);
     double a_max = std::numeric_limits<double>::infinity();
-    for (const auto* t : m.terms) a_max = std::min(a_max, t->max_step(x, dir));
+    for (const auto* t : m.dofs.terms()) a_max = std::min(a_max, t->max_step(x, dir));
     double alpha = std::min(1.0, 0.9 * a_max);
     const bool converged = p_inf / ip.dt < m.params.eps_d && pres_left == 0.0;
     // Armijo-type backtracking on E while the prescribed DOFs are at their

@@ -6,12 +6,13 @@
 // det F > 0) followed by backtracking, and the stop test |p|_inf / dt < eps_d.
 // Prescribed DOFs are driven toward their targets inside the same iterations:
 // their part of p is the remaining offset, so the filter also guards them.
-// Psi is a sum of EnergyTerms (FEM elements, MPM particles, ...); the system
-// graph is rebuilt only when set_system() says the structure changed.
+// Psi is a sum of EnergyTerms (FEM elements, MPM particles, contact); the DOF
+// space (solver/dof_space.hpp) owns the graph, its cache and the constraints.
 #include <Teuchos_ParameterList.hpp>
 #include <functional>
 #include <memory>
 
+#include "solver/dof_space.hpp"
 #include "solver/energy_term.hpp"
 #include "solver/linear_solver.hpp"
 #include "solver/slip_constraints.hpp"
@@ -29,6 +30,8 @@ struct NewtonStats {
   int linear_iterations = 0;
   double assembly_s = 0, solve_s = 0, line_search_s = 0;
   double min_step = 1.0;   // smallest accepted line-search step
+  int graph_builds = 0;            // graph rebuilds inside the solve (contact pairs outside the graph)
+  int symbolic_factorizations = 0; // direct solvers: symbolic phases run
 };
 
 // Inputs of one minimisation; all Views node-interleaved, length n_nodes*dim.
@@ -48,11 +51,11 @@ class NewtonSolver {
                NewtonParams params);
   ~NewtonSolver();
 
-  // Declares the unknowns (n_nodes * dim DOFs) and the terms of Psi. With
-  // `structure_changed` (or a new node count) the map, graph and matrix are
-  // rebuilt and the linear solver redoes its symbolic phase; otherwise the
-  // existing graph is reused. The terms must outlive the next minimize().
-  void set_system(LO n_nodes, std::vector<const EnergyTerm<dim>*> terms, bool structure_changed);
+  // Declares the unknowns (n_nodes * dim DOFs) and the terms of Psi. The DOF
+  // space rebuilds the graph (and the linear solver its symbolic phase) only
+  // when the node count or a term's couplings changed; returns true then. The
+  // terms must outlive the next minimize().
+  bool set_system(LO n_nodes, std::vector<const EnergyTerm<dim>*> terms);
 
   // Minimises E from the initial guess in `x` (overwritten with the result).
   // Throws SolverError when the linear solve fails, the line search stalls or
@@ -75,6 +78,7 @@ class NewtonSolver {
   SlipConstraints<dim>& slip_constraints();
 
   const LinearSolver& linear_solver() const;
+  const DofSpace<dim>& dof_space() const;
   Teuchos::RCP<const Map> dof_map() const;
   double last_graph_build_s() const;
 

@@ -7,8 +7,8 @@
 //     energy(), and every entry of the assembled Hessian (the whole dense
 //     n x n matrix: entries missing from the graph read 0) against central
 //     differences of gradient();
-//  2. some DOFs prescribed, as the Newton solver eliminates them
-//     (src/solver/newton.cpp, deformation_assemble, scatter_pair): the term
+//  2. some DOFs prescribed, as the DOF space's sink eliminates them
+//     (kernels/dof_sink.hpp, src/solver/dof_space.cpp): the term
 //     adds scale * dE/dx to every gradient entry, scale * H(free, free) to the
 //     free rows and columns of A, nothing to a prescribed row or column (the
 //     solver then puts an identity row there and rhs = dx_prescribed), and
@@ -192,7 +192,7 @@ Assembled assemble_dense(const EnergyTerm<dim>& term, LO n_nodes, Kokkos::View<d
     Kokkos::deep_copy(pres, ph);
     Kokkos::deep_copy(dxp, dh);
   }
-  term.assemble(x, scale, grad, A->getLocalMatrixDevice(), pres, dxp, rhs);
+  term.assemble(x, make_sink<dim>(A->getLocalMatrixDevice(), scale, grad, rhs, pres, dxp));
   Kokkos::fence();
   A->fillComplete();
   Assembled out;

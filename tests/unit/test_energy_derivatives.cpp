@@ -104,6 +104,9 @@ void mpm_case() {
     for (int c = 0; c < dim; ++c) x(k * dim + c) = xi(c) + disp(rng);
   }
   MpmElasticityTerm<dim> term("mpm", s);
+  ParticleCells<dim> cells;  // the colored, per-cell assembly
+  bin_particles<dim>(grid, p, cells);
+  term.set_cells(cells);
   check_term(term, n, x, 1e-7, 1e-5);
 }
 

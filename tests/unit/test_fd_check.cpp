@@ -56,9 +56,15 @@ class TestTerm : public EnergyTerm<2> {
   void gradient(ConstDofView x, double scale, DofView grad) const override {
     for (int i = 0; i < nd; ++i) grad(i) += scale * g(x, i);
   }
-  void assemble(ConstDofView x, double scale, DofView grad, const LocalMatrix& A, MaskView prescribed,
-                ConstDofView dx_prescribed, DofView rhs) const override {
-    gradient(x, scale, grad);
+  // Writes into the sink's matrix and vectors itself (not through
+  // add_stencil), so that each bug below can break one elimination rule.
+  void assemble(ConstDofView x, const Sink<2>& sink) const override {
+    const double scale = sink.scale;
+    const auto& A = sink.A;
+    const auto& prescribed = sink.prescribed;
+    const auto& dx_prescribed = sink.dx_prescribed;
+    const auto& rhs = sink.rhs;
+    gradient(x, scale, sink.grad);
     for (int i = 0; i < nd; ++i) {
       if (prescribed(i) && bug_ != Bug::prescribed_row) continue;
       for (int j = 0; j < nd; ++j) {

@@ -1,0 +1,135 @@
+#pragma once
+// Particles binned by the base node of their quadratic B-spline stencil (the
+// lowest node of their 3^dim support), rebuilt once per step on the device:
+//   cell n   = a grid node that is the base of at least one particle's stencil;
+//              all its particles share the same 3^dim nodes;
+//   color(n) = sum_d (i_d mod 3) 3^d, i the node's multi-index (9 colors in
+//              2D, 27 in 3D). Two cells of one color have bases 3k apart on
+//              some axis, so their supports (3 nodes wide) are disjoint: the
+//              cells of a color can be assembled in parallel without atomics.
+// Within a cell the particles are in increasing index order, so sums over a
+// cell do not depend on the thread count. The occupied set is compared with
+// the previous step's: `version` changes only when it does (the MPM part of
+// the Newton graph depends on nothing else).
+// No allocation per step unless the grid grows or the particle count changes.
+#include <Kokkos_Core.hpp>
+#include <array>
+#include <cstdint>
+
+#include "mpm/bspline.hpp"
+#include "mpm/grid.hpp"
+#include "mpm/particles.hpp"
+
+namespace bfemp {
+
+template <int dim>
+struct ParticleCells {
+  static constexpr int n_colors = dim == 2 ? 9 : 27;
+  Kokkos::View<LO*, MemSpace> count;        // per grid node: particles with that base
+  Kokkos::View<LO*, MemSpace> start;        // per grid node: first slot in `order`
+  Kokkos::View<LO*, MemSpace> order;        // particle ids, grouped by cell
+  Kokkos::View<LO*, MemSpace> cells;        // occupied base nodes, grouped by color
+  Kokkos::View<LO*, MemSpace> occupied_prev;  // last step's count > 0 flags
+  Kokkos::View<LO[n_colors + 1], MemSpace> color_start_dev;
+  Kokkos::View<LO[n_colors], MemSpace> color_cursor;
+  Kokkos::View<LO[n_colors + 1], Kokkos::HostSpace> color_start;  // host copy (28 ints)
+  LO n_cells = 0;
+  std::uint64_t version = 0;
+};
+
+template <int dim>
+KOKKOS_INLINE_FUNCTION int cell_color(const GridSpec<dim>& grid, LO node) {
+  const GridIndex<dim> i = grid.node_multi_index(node);
+  int c = 0, m = 1;
+  for (int d = 0; d < dim; ++d) {
+    c += (i[d] % 3) * m;
+    m *= 3;
+  }
+  return c;
+}
+
+template <int dim>
+void bin_particles(const GridSpec<dim>& grid, const Particles<dim>& p, ParticleCells<dim>& pc) {
+  constexpr int nc = ParticleCells<dim>::n_colors;
+  const LO n_nodes = grid.num_nodes();
+  const LO np = static_cast<LO>(p.size());
+  bool reshaped = false;
+  if (static_cast<LO>(pc.count.extent(0)) != n_nodes) {
+    pc.count = Kokkos::View<LO*, MemSpace>("mpm_cell_count", n_nodes);
+    pc.start = Kokkos::View<LO*, MemSpace>("mpm_cell_start", n_nodes);
+    pc.occupied_prev = Kokkos::View<LO*, MemSpace>("mpm_cell_occupied_prev", n_nodes);
+    pc.cells = Kokkos::View<LO*, MemSpace>("mpm_cells", n_nodes);
+    reshaped = true;
+  }
+  if (static_cast<LO>(pc.order.extent(0)) != np) pc.order = Kokkos::View<LO*, MemSpace>("mpm_cell_order", np);
+  if (pc.color_start_dev.data() == nullptr) {
+    pc.color_start_dev = decltype(pc.color_start_dev)("mpm_color_start");
+    pc.color_start = decltype(pc.color_start)("mpm_color_start_host");
+    pc.color_cursor = decltype(pc.color_cursor)("mpm_color_cursor");
+  }
+  auto count = pc.count;
+  auto start = pc.start;
+  auto order = pc.order;
+  auto cells = pc.cells;
+  auto prev = pc.occupied_prev;
+  auto cs = pc.color_start_dev;
+  Kokkos::deep_copy(count, 0);
+  Kokkos::deep_copy(cs, 0);
+  auto base_of = KOKKOS_LAMBDA(const LO q) {
+    const auto st = bspline_stencil(grid, particle_position(p, q));
+    return node_index(grid, st, 0);
+  };
+  Kokkos::parallel_for(
+      "mpm_cell_count", Kokkos::RangePolicy<ExecSpace>(0, np),
+      KOKKOS_LAMBDA(const LO q) { Kokkos::atomic_increment(&count(base_of(q))); });
+  // Slots per cell; occupied cells per color; changes against the last step.
+  LO changed = 0;
+  Kokkos::parallel_reduce(
+      "mpm_cell_colors", Kokkos::RangePolicy<ExecSpace>(0, n_nodes),
+      KOKKOS_LAMBDA(const LO n, LO& acc) {
+        const LO occ = count(n) > 0 ? 1 : 0;
+        if (occ) Kokkos::atomic_increment(&cs(cell_color(grid, n) + 1));
+        if (occ != prev(n)) ++acc;
+        prev(n) = occ;
+      },
+      changed);
+  Kokkos::parallel_scan(
+      "mpm_cell_start", Kokkos::RangePolicy<ExecSpace>(0, n_nodes),
+      KOKKOS_LAMBDA(const LO n, LO& offset, const bool final) {
+        if (final) start(n) = offset;
+        offset += count(n);
+      });
+  Kokkos::deep_copy(pc.color_start, cs);
+  for (int c = 0; c < nc; ++c) pc.color_start(c + 1) += pc.color_start(c);
+  Kokkos::deep_copy(cs, pc.color_start);
+  pc.n_cells = pc.color_start(nc);
+  // Fill: `count` is reused as the cursor (restored to the counts after).
+  Kokkos::deep_copy(count, 0);
+  Kokkos::parallel_for(
+      "mpm_cell_fill", Kokkos::RangePolicy<ExecSpace>(0, np), KOKKOS_LAMBDA(const LO q) {
+        const LO b = base_of(q);
+        order(start(b) + Kokkos::atomic_fetch_add(&count(b), 1)) = q;
+      });
+  auto cursor = pc.color_cursor;
+  Kokkos::deep_copy(cursor, 0);
+  Kokkos::parallel_for(
+      "mpm_cell_sort", Kokkos::RangePolicy<ExecSpace>(0, n_nodes), KOKKOS_LAMBDA(const LO n) {
+        const LO k = count(n);
+        if (k == 0) return;
+        // Increasing particle index within the cell (insertion sort; a few particles).
+        for (LO i = start(n) + 1; i < start(n) + k; ++i) {
+          const LO v = order(i);
+          LO j = i - 1;
+          while (j >= start(n) && order(j) > v) {
+            order(j + 1) = order(j);
+            --j;
+          }
+          order(j + 1) = v;
+        }
+        const int c = cell_color(grid, n);
+        cells(cs(c) + Kokkos::atomic_fetch_add(&cursor(c), 1)) = n;
+      });
+  if (changed > 0 || reshaped) ++pc.version;
+}
+
+}  // namespace bfemp
