@@ -71,8 +71,9 @@ void deformation_gradient(const DeformationStencils<dim, nv>& s, Kokkos::View<co
 //   gl(a dim + k)            += V sum_j P_kj g_aj
 //   Hl(a dim + k, b dim + l) += V sum_{j,m} g_aj (dP/dF)_{kj,lm} g_bm
 // with dP/dF projected onto the PSD cone when `project` (the exact tangent
-// otherwise, for derivative tests). Only the upper triangle of Hl (row <=
-// column) is written; symmetric_from_upper() completes it.
+// otherwise, for derivative tests). Only the lower triangle of Hl (row >=
+// column, contiguous in Eigen's column-major storage) is written;
+// symmetric_from_lower() completes it.
 template <int dim, int nv, class XView>
 KOKKOS_INLINE_FUNCTION void deformation_local_add(const DeformationStencils<dim, nv>& s, const XView& x, LO q,
                                                   bool project, Eigen::Matrix<double, nv * dim, 1>& gl,
@@ -94,31 +95,32 @@ KOKKOS_INLINE_FUNCTION void deformation_local_add(const DeformationStencils<dim,
       for (int j = 0; j < dim; ++j) v += P(k, j) * gq[a][j];
       gl(a * dim + k) += w * v;
     }
-  // DB(:, b dim + l) = w sum_m D(:, l + dim m) g_bm
-  Eigen::Matrix<double, dd, nd> DB;
-  for (int b = 0; b < nv; ++b)
-    for (int l = 0; l < dim; ++l) {
-      for (int r = 0; r < dd; ++r) {
+  // DB[r][b dim + l] = w sum_m D(r, l + dim m) g_bm, rows contiguous.
+  double DB[dd][nd];
+  for (int r = 0; r < dd; ++r)
+    for (int b = 0; b < nv; ++b)
+      for (int l = 0; l < dim; ++l) {
         double v = 0;
         for (int m = 0; m < dim; ++m) v += D(r, l + dim * m) * gq[b][m];
-        DB(r, b * dim + l) = w * v;
+        DB[r][b * dim + l] = w * v;
       }
-    }
+  // Column c = a dim + k of Hl, rows r >= c: sum_j g_aj DB[k + dim j][r].
   for (int a = 0; a < nv; ++a)
     for (int k = 0; k < dim; ++k) {
-      const int r = a * dim + k;
-      for (int c = r; c < nd; ++c) {
-        double h = 0;
-        for (int j = 0; j < dim; ++j) h += DB(k + dim * j, c) * gq[a][j];
-        Hl(r, c) += h;
+      const int c = a * dim + k;
+      double* col = &Hl(0, c);
+      for (int j = 0; j < dim; ++j) {
+        const double gj = gq[a][j];
+        const double* row = DB[k + dim * j];
+        for (int r = c; r < nd; ++r) col[r] += gj * row[r];
       }
     }
 }
 
 template <int n>
-KOKKOS_INLINE_FUNCTION void symmetric_from_upper(SquareMat<n>& H) {
-  for (int r = 1; r < n; ++r)
-    for (int c = 0; c < r; ++c) H(r, c) = H(c, r);
+KOKKOS_INLINE_FUNCTION void symmetric_from_lower(SquareMat<n>& H) {
+  for (int c = 1; c < n; ++c)
+    for (int r = 0; r < c; ++r) H(r, c) = H(c, r);
 }
 
 // scale * (gradient, PSD-projected Hessian) of every stencil into the sink,
@@ -133,7 +135,7 @@ void deformation_assemble(const DeformationStencils<dim, nv>& s, Kokkos::View<co
         Eigen::Matrix<double, nd, 1> gl = Eigen::Matrix<double, nd, 1>::Zero();
         SquareMat<nd> Hl = SquareMat<nd>::Zero();
         deformation_local_add<dim, nv>(s, x, q, project, gl, Hl);
-        symmetric_from_upper<nd>(Hl);
+        symmetric_from_lower<nd>(Hl);
         LO nodes[nv];
         for (int a = 0; a < nv; ++a) nodes[a] = s.nodes(q, a);
         sink.add_stencil(nodes, nv, gl, &Hl);

@@ -29,6 +29,7 @@
 
 #include <sys/resource.h>
 
+#include "bench_json.hpp"
 #include "materials/lame.hpp"
 #include "mpm/sampling.hpp"
 #include "sim/simulation.hpp"
@@ -37,6 +38,7 @@
 namespace {
 
 using namespace bfemp;
+using namespace bfemp::bench;
 
 std::vector<std::string> split(const std::string& s) {
   std::vector<std::string> out;
@@ -100,45 +102,7 @@ Options parse(int argc, char** argv) {
   return o;
 }
 
-std::string jstr(const std::string& s) {
-  std::string o = "\"";
-  for (char c : s) {
-    if (c == '"' || c == '\\') o += '\\';
-    if (static_cast<unsigned char>(c) >= 0x20) o += c;
-  }
-  return o + "\"";
-}
-std::string jnum(double v) {
-  if (!std::isfinite(v)) return "null";
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.6g", v);
-  return buf;
-}
-std::string jlist(const std::vector<double>& v) {
-  std::string o = "[";
-  for (std::size_t i = 0; i < v.size(); ++i) o += (i ? ", " : "") + jnum(v[i]);
-  return o + "]";
-}
-struct Json {
-  std::vector<std::pair<std::string, std::string>> kv;
-  Json& num(const std::string& k, double v) { kv.emplace_back(k, jnum(v)); return *this; }
-  Json& integer(const std::string& k, long long v) { kv.emplace_back(k, std::to_string(v)); return *this; }
-  Json& str(const std::string& k, const std::string& v) { kv.emplace_back(k, jstr(v)); return *this; }
-  Json& raw(const std::string& k, const std::string& v) { kv.emplace_back(k, v); return *this; }
-  std::string dump(int indent) const {
-    const std::string pad(indent + 2, ' ');
-    std::string o = "{\n";
-    for (std::size_t i = 0; i < kv.size(); ++i)
-      o += pad + jstr(kv[i].first) + ": " + kv[i].second + (i + 1 < kv.size() ? ",\n" : "\n");
-    return o + std::string(indent, ' ') + "}";
-  }
-};
 
-double cpu_seconds() {
-  rusage u{};
-  getrusage(RUSAGE_SELF, &u);
-  return u.ru_utime.tv_sec + 1e-6 * u.ru_utime.tv_usec + u.ru_stime.tv_sec + 1e-6 * u.ru_stime.tv_usec;
-}
 
 // The block: unit square/cube [0,1]^dim, ppc 4 (2D) / 8 (3D), dx giving about
 // `target` particles, on a no-slip half-plane ground at y = 0.

@@ -31,6 +31,7 @@
 #include <sys/resource.h>
 
 #include "io/shape_mesher.hpp"
+#include "bench_json.hpp"
 #include "materials/lame.hpp"
 #include "materials/material.hpp"
 #include "sim/simulation.hpp"
@@ -40,6 +41,7 @@
 namespace {
 
 using namespace bfemp;
+using namespace bfemp::bench;
 
 // ---------------------------------------------------------------- options --
 
@@ -207,53 +209,11 @@ SimulationSetup<dim> make_setup(const MeshData& mesh, const Teuchos::ParameterLi
 
 // ------------------------------------------------------------------- JSON --
 
-std::string jstr(const std::string& s) {
-  std::string o = "\"";
-  for (char c : s) {
-    if (c == '"' || c == '\\') {
-      o += '\\';
-      o += c;
-    } else if (static_cast<unsigned char>(c) < 0x20) {
-      char buf[8];
-      std::snprintf(buf, sizeof buf, "\\u%04x", c);
-      o += buf;
-    } else {
-      o += c;
-    }
-  }
-  return o + "\"";
-}
 
-std::string jnum(double v) {
-  if (!std::isfinite(v)) return "null";
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.6g", v);
-  return buf;
-}
 
-struct Json {  // flat key -> raw JSON value, kept in insertion order
-  std::vector<std::pair<std::string, std::string>> kv;
-  Json& num(const std::string& k, double v) { kv.emplace_back(k, jnum(v)); return *this; }
-  Json& integer(const std::string& k, long long v) { kv.emplace_back(k, std::to_string(v)); return *this; }
-  Json& str(const std::string& k, const std::string& v) { kv.emplace_back(k, jstr(v)); return *this; }
-  Json& raw(const std::string& k, const std::string& v) { kv.emplace_back(k, v); return *this; }
-  std::string dump(int indent) const {
-    const std::string pad(indent + 2, ' ');
-    std::string o = "{\n";
-    for (std::size_t i = 0; i < kv.size(); ++i)
-      o += pad + jstr(kv[i].first) + ": " + kv[i].second + (i + 1 < kv.size() ? ",\n" : "\n");
-    return o + std::string(indent, ' ') + "}";
-  }
-};
 
 // -------------------------------------------------------------- benchmark --
 
-double cpu_seconds() {  // user + system time of the whole process (all threads)
-  rusage u{};
-  getrusage(RUSAGE_SELF, &u);
-  return u.ru_utime.tv_sec + 1e-6 * u.ru_utime.tv_usec + u.ru_stime.tv_sec +
-         1e-6 * u.ru_stime.tv_usec;
-}
 
 double loadavg1() {  // 1-minute load average (other users of the machine)
   double l = -1;
@@ -264,11 +224,6 @@ double loadavg1() {  // 1-minute load average (other users of the machine)
   return l;
 }
 
-std::string jlist(const std::vector<double>& v) {
-  std::string o = "[";
-  for (std::size_t i = 0; i < v.size(); ++i) o += (i ? ", " : "") + jnum(v[i]);
-  return o + "]";
-}
 
 // Time steps per configuration (each takes 3 Newton iterations in this
 // scene): more where an iteration is cheap, to average out noise; one for the

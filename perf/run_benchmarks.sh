@@ -1,9 +1,9 @@
 #!/usr/bin/env bash
-# Runs the Newton-iteration benchmark (perf/bench_newton) at 1 and 2 OpenMP
+# Runs a benchmark (default perf/bench_newton) at 1 and 2 OpenMP
 # threads and merges both runs into one JSON with the machine's description.
 # Builds nothing: build first with  ninja -C build bench_newton
 #
-#   perf/run_benchmarks.sh [--bench bench_newton|bench_mpm_newton|bench_ccd] [--build-dir DIR]
+#   perf/run_benchmarks.sh [--bench bench_newton|bench_mpm_newton|bench_ccd|bench_assembly] [--build-dir DIR]
 #                          [--out FILE] [--threads "1 2"]
 #                          [--wait-quiet SECONDS] [-- options passed to the benchmark]
 #
@@ -40,7 +40,8 @@ case "$bench" in
   bench_newton) bench_json=newton; bench_name=newton_iteration ;;
   bench_mpm_newton) bench_json=mpm_newton; bench_name=mpm_newton_iteration ;;
   bench_ccd) bench_json=ccd; bench_name=ccd_queries; [[ -n "$threads" ]] || threads="1" ;;
-  *) echo "run_benchmarks.sh: --bench '$bench': expected bench_newton, bench_mpm_newton or bench_ccd" >&2; exit 2 ;;
+  bench_assembly) bench_json=assembly; bench_name=assembly ;;
+  *) echo "run_benchmarks.sh: --bench '$bench': expected bench_newton, bench_mpm_newton, bench_ccd or bench_assembly" >&2; exit 2 ;;
 esac
 [[ -n "$threads" ]] || threads="1 2"
 [[ -n "$out" ]] || out="$build_dir/perf/$bench_json.json"

@@ -44,7 +44,7 @@ void MpmElasticityTerm<dim>::assemble(ConstDofView x, const Sink<dim>& sink) con
           SquareMat<nd> Hl = SquareMat<nd>::Zero();
           const LO first = start(n), last = start(n) + count(n);
           for (LO i = first; i < last; ++i) deformation_local_add<dim, ns>(s, x, order(i), project, gl, Hl);
-          symmetric_from_upper<nd>(Hl);
+          symmetric_from_lower<nd>(Hl);
           LO nodes[ns];
           for (int a = 0; a < ns; ++a) nodes[a] = s.nodes(order(first), a);
           plain.add_stencil(nodes, ns, gl, &Hl);

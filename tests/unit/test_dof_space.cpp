@@ -45,7 +45,7 @@ Dense dense_reference(const DeformationStencils<dim, nv>& s, Kokkos::View<const 
     Eigen::Matrix<double, L, 1> g = Eigen::Matrix<double, L, 1>::Zero();
     SquareMat<L> H = SquareMat<L>::Zero();
     deformation_local_add<dim, nv>(s, x, q, true, g, H);
-    symmetric_from_upper<L>(H);
+    symmetric_from_lower<L>(H);
     for (int r = 0; r < L; ++r) {
       const std::size_t row = s.nodes(q, r / dim) * dim + r % dim;
       d.grad[row] += scale * g(r);
