@@ -174,8 +174,11 @@ struct ExplicitSimulation<dim>::Impl {
         },
         Kokkos::Max<LO>(bad));
     if (bad >= 0) {
+      auto xh = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), p.x);
       std::ostringstream m;
-      m << "explicit MPM: particle " << bad << " " << when << " (step " << step
+      m << "explicit MPM: particle " << bad << " at (";
+      for (int d = 0; d < dim; ++d) m << (d ? ", " : "") << xh(bad, d);
+      m << ") " << when << " (step " << step
         << ") has a shape-function stencil outside the grid; enlarge MPM/domain min / domain max";
       if (when == "at the start") throw std::invalid_argument(m.str());
       throw std::runtime_error(m.str());
