@@ -9,6 +9,7 @@
 
 #include "io/gmsh_reader.hpp"
 #include "io/scene_checks.hpp"
+#include "io/scene_explicit.hpp"
 #include "io/scene_validate.hpp"
 #include "io/scene_yaml.hpp"
 #include "io/shape_mesher.hpp"
@@ -57,8 +58,10 @@ Scene finish(ParameterList raw, const std::string& path, const std::string& base
       if (mats.entry(it).isList() && mats.sublist(mats.name(it)).numParams() == 0)
         bad("Materials/" + mats.name(it), "(nothing)", "a material with its keys (model, E, nu, density)");
   }
+  check_solver_keys(raw);
   validate_scene_list(raw, *schema, "");
   check_scene_values(raw);
+  check_explicit_values(raw);
   Scene s;
   s.path = path;
   s.base_dir = base_dir;

@@ -21,8 +21,12 @@ void choice(ParameterList& pl, const std::string& key, const std::string& def, c
 
 ParameterList material_schema() {
   ParameterList m("material");
-  choice(m, "model", "neo-hookean", "constitutive model (paper Eq. 7, or small-strain linear)",
-         tuple<std::string>("neo-hookean", "linear"));
+  choice(m, "model", "neo-hookean",
+         "constitutive model (paper Eq. 7, or small-strain linear; hyperelastic-kg: paper 001 Eq. 18 with K, G, "
+         "explicit scenes only)",
+         tuple<std::string>("neo-hookean", "linear", "hyperelastic-kg"));
+  m.set("K", 0.0, "bulk modulus (Pa), > 0 (model hyperelastic-kg)");
+  m.set("G", 0.0, "shear modulus (Pa), > 0 (model hyperelastic-kg)");
   m.set("E", 1e6, "Young's modulus (Pa), > 0");
   m.set("nu", 0.3, "Poisson ratio, in (-1, 0.5)");
   m.set("density", 1000.0, "rest density (kg/m^3; kg/m^2 in 2D), > 0");
@@ -130,10 +134,15 @@ bool scene_is_container(const std::string& name) {
 Teuchos::RCP<const ParameterList> scene_schema() {
   auto pl = Teuchos::rcp(new ParameterList("bfemp"));
   pl->set("dimension", 2, "2 (triangles, plane strain) or 3 (tetrahedra)");
+  choice(*pl, "Solver", "implicit",
+         "implicit: barrier-coupled Newton stepper (paper 000); explicit: multimaterial MPM with grid contact "
+         "(paper 001; MPM bodies only)",
+         tuple<std::string>("implicit", "explicit"));
   pl->set("gravity", Array<double>(), "m/s^2, dim components (default none)");
   auto& time = pl->sublist("Time", false, "time stepping");
   time.set("dt", 1e-3, "time step (s), > 0");
   time.set("end time", 1e-2, "simulated time (s), > 0");
+  time.set("CFL", 0.5, "explicit: dt = CFL dx / max(c + |v|) when Time/dt is not given, in (0, 1]");
   choice(time, "integrator", "backward-euler", "paper Eqs. 21-22",
          tuple<std::string>("backward-euler", "newmark"));
   auto& nm = time.sublist("Newmark", false, "Newmark parameters (paper Eq. 21)");
@@ -162,6 +171,25 @@ Teuchos::RCP<const ParameterList> scene_schema() {
          "the step, or extend the grid by whole cells before the step",
          tuple<std::string>("error", "extend"));
   pl->sublist("MPM Bodies", false, "named MPM bodies (particles)").disableRecursiveValidation();
+  auto& ex = pl->sublist("Explicit", false, "explicit multimaterial MPM (Solver: explicit; paper 001)");
+  choice(ex, "shape functions", "uGIMP", "grid shape functions", tuple<std::string>("uGIMP", "quadratic B-spline"));
+  choice(ex, "update", "FLIP", "particle update (Eqs. 32, 38, 41)", tuple<std::string>("FLIP", "PIC", "XPIC"));
+  ex.set("XPIC order", 5, "m of XPIC(m), >= 1");
+  choice(ex, "XPIC correction", "corrected", "multimaterial term of Eq. 37 (uncorrected: without it)",
+         tuple<std::string>("corrected", "uncorrected"));
+  ex.set("contact passes", 2, "contact corrections per step: 2 (Eqs. 26, 31) or 1 (pass 2 only)");
+  choice(ex, "normals", "LR", "contact normal and separation: logistic regression (Eqs. 19-25) or AG (Eq. 13)",
+         tuple<std::string>("LR", "AG"));
+  choice(ex, "separation", "velocity", "AG only: approach alone (Eq. 14) or CP offset (Eq. 16)",
+         tuple<std::string>("velocity", "CP"));
+  ex.set("CP", 0.8, "delta_c of Eq. 16 in cells, > 0");
+  choice(ex, "law", "coulomb", "contact law of every pair of material classes (Eqs. 7-10)",
+         tuple<std::string>("frictionless", "coulomb", "stick"));
+  ex.set("mu", 0.0, "Coulomb friction coefficient, >= 0");
+  ex.set("stress body", std::string(""), "MPM body whose mean axial stress goes to diagnostics.csv (default: all)");
+  ex.set("stress axis", -1, "axis of that stress (0..dim-1; -1: the last axis)");
+  ex.set("fixed dt", false,
+         "true: Time/dt as given (refused above the CFL limit at t = 0); set by the loader when the scene gives Time/dt");
   pl->sublist("Level Sets", false, "grid boundaries of the MPM bodies").disableRecursiveValidation();
   auto& contact = pl->sublist("Contact", false,
                               "barrier contact between MPM particles and FEM boundaries (paper section 4); on when the "

@@ -9,7 +9,9 @@
 #include <ostream>
 #include <sstream>
 
+#include "explicit/explicit_run.hpp"
 #include "io/run_output.hpp"
+#include "io/scene_explicit.hpp"
 #include "sim/interrupt.hpp"
 
 namespace bfemp {
@@ -254,6 +256,15 @@ std::vector<std::string> checkpoint_overrides(const Checkpoint& c, const std::ve
 
 RunSummary run_scene(const Scene& scene, const std::string& dir, const Teuchos::RCP<const Comm>& comm,
                      std::ostream& log, const RunOptions& options) {
+  if (is_explicit(scene)) {  // the explicit stepper: no Newton solver, Tpetra matrix or contact hash
+    if (options.restart) throw std::invalid_argument("restart: explicit scenes (Solver: explicit) have no restart yet");
+    const ExplicitRunSummary e = run_explicit_scene(scene, dir, log);
+    RunSummary s;
+    s.steps = e.steps;
+    s.frames = e.frames;
+    s.wall_s = e.wall_s;
+    return s;
+  }
   RunSummary s = scene.dim() == 2 ? run_dim<2>(scene, dir, comm, log, options)
                                   : run_dim<3>(scene, dir, comm, log, options);
   log << "\nsummary\n"
