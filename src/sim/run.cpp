@@ -137,6 +137,7 @@ void accumulate(RunSummary& s, const StepReport& r) {
   s.contact_broad_phase_s += r.contact_broad_phase_s;
   s.contact_eval_s += r.contact_eval_s;
   s.contact_ccd_s += r.contact_ccd_s;
+  s.symbolic_factorizations += r.newton.symbolic_factorizations;
 }
 
 // The signal any rank received (every rank stops after the same step).
@@ -170,6 +171,11 @@ RunSummary run_dim(const Scene& scene, const std::string& dir, const Teuchos::RC
     log << "; MPM: " << mpm->particles().size() << " particles, " << transfer_scheme_name(mpm->scheme())
         << ", grid " << mpm->grid().num_nodes() << " nodes (dx " << mpm->grid().dx << ")";
   log << "; linear solver: " << sim.newton().linear_solver().describe() << "\n";
+  {
+    std::string names;
+    for (const auto& n : sim.term_names()) names += (names.empty() ? "" : ", ") + n;
+    log << "energy terms: inertia, " << names << "\n";
+  }
   OutputResume resume;
   if (opt.restart && opt.append) resume = {opt.restart->frames, opt.restart->step};
   // A new output must not keep an older run's checkpoint: restarting from it
@@ -226,6 +232,8 @@ RunSummary run_dim(const Scene& scene, const std::string& dir, const Teuchos::RC
   out.close();
   s.frames = out.frames_written();
   s.wall_s = wall.seconds();
+  for (const auto& [name, sec] : sim.newton().term_assembly_seconds()) s.term_assembly_s.emplace_back(name, sec);
+  s.graph_builds = sim.newton().dof_space().graph_builds();
   return s;
 }
 
@@ -272,7 +280,12 @@ RunSummary run_scene(const Scene& scene, const std::string& dir, const Teuchos::
       << "  Newton iterations   " << s.newton_iterations << " (" << std::setprecision(3)
       << (s.steps ? double(s.newton_iterations) / s.steps : 0.0) << " per step)\n"
       << "  linear iterations   " << s.linear_iterations << "\n"
-      << "  assembly time       " << s.assembly_s << " s\n"
+      << "  assembly time       " << s.assembly_s << " s\n";
+  for (const auto& [name, sec] : s.term_assembly_s)
+    log << "    " << std::left << std::setw(18) << name << std::right << sec << " s ("
+        << std::setprecision(3) << (s.assembly_s > 0 ? 100.0 * sec / s.assembly_s : 0.0) << " %)\n";
+  log << "  graph builds        " << s.graph_builds << " (symbolic factorisations " << s.symbolic_factorizations
+      << ")\n"
       << "  linear-solve time   " << s.solve_s << " s\n"
       << "  line-search time    " << s.line_search_s << " s\n";
   if (s.contact)

@@ -7,6 +7,7 @@
 // Interrupted (the driver exits 130 / 143).
 #include <iosfwd>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "io/checkpoint.hpp"
@@ -23,6 +24,8 @@ struct RunSummary {
   double contact_broad_phase_s = 0, contact_eval_s = 0, contact_ccd_s = 0;  // parts of the above
   int frames = 0;
   int checkpoints = 0;
+  long graph_builds = 0, symbolic_factorizations = 0;
+  std::vector<std::pair<std::string, double>> term_assembly_s;  // per energy term
 };
 
 struct RunOptions {

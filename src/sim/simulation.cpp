@@ -81,6 +81,7 @@ Simulation<dim>::Simulation(SimulationSetup<dim> setup, const Teuchos::RCP<const
     }
   Kokkos::deep_copy(v_, v);
   Kokkos::deep_copy(prescribed_, pres);
+  motions_ = device_motions(setup_.motions);
   if (setup_.contact && mpm_ && mesh_.num_nodes() > 0) {
     contact_ = std::make_unique<Contact<dim>>(mesh_, *setup_.contact);
     contact_->check_initial(mpm_->particles(), x_);
@@ -99,6 +100,18 @@ template <int dim>
 Simulation<dim>::~Simulation() = default;
 
 template <int dim>
+std::vector<std::string> Simulation<dim>::term_names() const {
+  std::vector<std::string> names;
+  if (mesh_.num_nodes() > 0) names.push_back(elasticity_->name());
+  if (mpm_) names.push_back(mpm_->term().name());
+  if (contact_) {
+    names.push_back(contact_->barrier()->name());
+    if (contact_->has_friction()) names.push_back(contact_->friction()->name());
+  }
+  return names;
+}
+
+template <int dim>
 void Simulation<dim>::reset_acceleration() {
   auto a = a_;
   auto m = mass_;
@@ -114,37 +127,37 @@ void Simulation<dim>::reset_acceleration() {
 
 template <int dim>
 void Simulation<dim>::apply_prescribed_targets(double t, View1 target) const {
-  auto tgt = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), target);
-  auto X0 = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), initial_position_);
-  for (const auto& mo : setup_.motions)
-    for (LO node : mo.nodes) {
-      Vec<dim> X;
-      for (int c = 0; c < dim; ++c) X(c) = X0(node * dim + c);
-      const Vec<dim> p = mo.template position<dim>(X, t);
-      for (int c = 0; c < dim; ++c) tgt(node * dim + c) = p(c);
-    }
-  Kokkos::deep_copy(target, tgt);
+  const auto mo = motions_;
+  const auto X0 = initial_position_;
+  Kokkos::parallel_for(
+      "fem_prescribed_targets", Kokkos::RangePolicy<ExecSpace>(0, mo.size()), KOKKOS_LAMBDA(const LO k) {
+        const LO node = mo.node(k);
+        Vec<dim> X;
+        for (int c = 0; c < dim; ++c) X(c) = X0(node * dim + c);
+        const Vec<dim> p = motion_position<dim>(&mo.segments(mo.range(k, 0)), mo.range(k, 1), X, t);
+        for (int c = 0; c < dim; ++c) target(node * dim + c) = p(c);
+      });
 }
 
 template <int dim>
 void Simulation<dim>::prescribed_velocities(double t1) {
-  if (setup_.motions.empty()) return;
+  if (motions_.size() == 0) return;
   const double dt = setup_.dt;
-  auto vh = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), v_);
-  auto ah = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), a_);
-  auto X0 = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), initial_position_);
-  for (const auto& mo : setup_.motions)
-    for (LO node : mo.nodes) {
-      Vec<dim> X;
-      for (int c = 0; c < dim; ++c) X(c) = X0(node * dim + c);
-      const Vec<dim> vel = mo.template velocity<dim>(X, t1);
-      for (int c = 0; c < dim; ++c) {
-        ah(node * dim + c) = (vel(c) - vh(node * dim + c)) / dt;
-        vh(node * dim + c) = vel(c);
-      }
-    }
-  Kokkos::deep_copy(v_, vh);
-  Kokkos::deep_copy(a_, ah);
+  const auto mo = motions_;
+  const auto X0 = initial_position_;
+  auto v = v_;
+  auto a = a_;
+  Kokkos::parallel_for(
+      "fem_prescribed_velocities", Kokkos::RangePolicy<ExecSpace>(0, mo.size()), KOKKOS_LAMBDA(const LO k) {
+        const LO node = mo.node(k);
+        Vec<dim> X;
+        for (int c = 0; c < dim; ++c) X(c) = X0(node * dim + c);
+        const Vec<dim> vel = motion_velocity<dim>(&mo.segments(mo.range(k, 0)), mo.range(k, 1), X, t1);
+        for (int c = 0; c < dim; ++c) {
+          a(node * dim + c) = (vel(c) - v(node * dim + c)) / dt;
+          v(node * dim + c) = vel(c);
+        }
+      });
 }
 
 // Grid nodes that a particle's stencil reaches with weight 0 (a particle at a
@@ -218,21 +231,26 @@ StepReport Simulation<dim>::step() {
       if (contact_->has_friction()) terms.push_back(contact_->friction());
     }
     graph_rebuilt = newton_->set_system(nF + nA, terms);
-    // Grid a^n = g - M^-1 grad Psi(x^n) (the Newmark predictor needs it).
-    auto work = System::head(S.work, nd);
-    Kokkos::deep_copy(work, 0.0);
-    newton_->potential_gradient(x, -1.0, work);
+    // Grid a^n = g - M^-1 grad Psi(x^n): the Newmark predictor and velocity
+    // update need it; backward Euler (no a^n term in either) does not.
     const std::size_t off = nfd;
-    Kokkos::parallel_for(
-        "grid_a0", Kokkos::RangePolicy<ExecSpace>(off, nd),
-        KOKKOS_LAMBDA(const std::size_t i) { a(i) = mass(i) > 0 ? work(i) / mass(i) + g[i % dim] : 0.0; });
+    if (ca != 0.0 || ti.gamma != 1.0) {
+      auto work = System::head(S.work, nd);
+      Kokkos::deep_copy(work, 0.0);
+      newton_->potential_gradient(x, -1.0, work);
+      Kokkos::parallel_for(
+          "grid_a0", Kokkos::RangePolicy<ExecSpace>(off, nd),
+          KOKKOS_LAMBDA(const std::size_t i) { a(i) = mass(i) > 0 ? work(i) / mass(i) + g[i % dim] : 0.0; });
+    } else {
+      Kokkos::deep_copy(Kokkos::subview(a, std::make_pair(off, nd)), 0.0);
+    }
     Kokkos::deep_copy(v_old, v);
   }
   Kokkos::parallel_for(
       "predictor", Kokkos::RangePolicy<ExecSpace>(0, nd), KOKKOS_LAMBDA(const std::size_t i) {
         xhat(i) = x(i) + dt * v(i) + ca * a(i) + h * g[i % dim];
       });
-  if (!setup_.motions.empty()) apply_prescribed_targets(t1, target);
+  if (motions_.size() > 0) apply_prescribed_targets(t1, target);
 
   IncrementalPotential ip{xhat, mass, pres, target, h, dt};
   NewtonStats ns;

@@ -98,6 +98,9 @@ class Simulation {
   const MpmBodies<dim>* mpm() const { return mpm_.get(); }
   NewtonSolver<dim>& newton() { return *newton_; }
   const Contact<dim>* contact() const { return contact_.get(); }
+  // The energy terms this scene built (names, in assembly order): only what
+  // it needs (no MPM, contact or friction term unless the scene has them).
+  std::vector<std::string> term_names() const;
   // FEM node-interleaved state; tests may set initial velocities before step().
   Kokkos::View<double*, MemSpace> positions() const { return x_; }
   Kokkos::View<double*, MemSpace> velocities() const { return v_; }
@@ -124,6 +127,7 @@ class Simulation {
   LevelSetList level_sets_;
   Kokkos::View<double*, MemSpace> x_, v_, a_, mass_, initial_position_;
   Kokkos::View<int*, MemSpace> prescribed_;
+  DeviceMotions motions_;  // prescribed nodes and their segments, on the device
   double time_ = 0;
   long step_ = 0;
 };

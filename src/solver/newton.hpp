@@ -10,6 +10,8 @@
 // space (solver/dof_space.hpp) owns the graph, its cache and the constraints.
 #include <Teuchos_ParameterList.hpp>
 #include <functional>
+#include <map>
+#include <string>
 #include <memory>
 
 #include "solver/dof_space.hpp"
@@ -81,6 +83,8 @@ class NewtonSolver {
   const DofSpace<dim>& dof_space() const;
   Teuchos::RCP<const Map> dof_map() const;
   double last_graph_build_s() const;
+  // Seconds each term (by name) has spent in assemble() since construction.
+  const std::map<std::string, double>& term_assembly_seconds() const;
 
  private:
   struct Impl;
