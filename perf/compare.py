@@ -31,6 +31,28 @@ DEFAULT_BASELINE = os.path.join(os.path.dirname(os.path.abspath(__file__)),
 DEFAULT_FIELDS = "assembly_s,solve_s,line_search_s"
 
 
+def flatten_runs(data):
+    """The older per-thread layout of run_contact.sh / run_transfers.sh
+    ({"runs": [{"threads": t, "cases": [...]}, ...]}) as a results list:
+    dim (2 unless the case says), size = the case's particle count (and facet
+    count), solver = the benchmark name, threads from the run."""
+    results = []
+    for run in data.get("runs", []):
+        if not isinstance(run, dict) or "cases" not in run:
+            continue
+        for case in run["cases"]:
+            r = dict(case)
+            r["threads"] = run.get("threads", 1)
+            r.setdefault("dim", 2)
+            size = str(case.get("particles", ""))
+            if "facets" in case:
+                size += "/" + str(case["facets"])
+            r["size"] = size
+            r["solver"] = data.get("benchmark", "")
+            results.append(r)
+    return results
+
+
 def load(path):
     try:
         with open(path) as f:
@@ -38,6 +60,8 @@ def load(path):
     except (OSError, ValueError) as e:
         print(f"compare.py: cannot read {path}: {e}", file=sys.stderr)
         sys.exit(2)
+    if "results" not in data and "runs" in data:
+        data["results"] = flatten_runs(data)
     if "results" not in data:
         print(f"compare.py: {path} has no 'results' (not a bench_newton output?)",
               file=sys.stderr)

@@ -1,9 +1,12 @@
 #!/usr/bin/env bash
-# Runs bench_contact at 1 and 2 threads; writes perf/baselines/contact.json
-# (or the file given as $1).   Needs a build in ./build.
+# Runs bench_contact at 1 and 2 threads; writes build/perf/contact.json (or the
+# file given as $1; pass perf/baselines/contact.json to record a new baseline,
+# on a quiet machine). Needs a build in ./build. Compare with the baseline:
+#   python3 perf/compare.py build/perf/contact.json --baseline perf/baselines/contact.json --fields FIELDS
 set -euo pipefail
 cd "$(dirname "$0")/.."
-out=${1:-perf/baselines/contact.json}
+out=${1:-build/perf/contact.json}
+mkdir -p "$(dirname "$out")"
 tmp=$(mktemp -d)
 for t in 1 2; do
   OMP_NUM_THREADS=$t OMP_PROC_BIND=spread OMP_PLACES=threads build/perf/bench_contact --out "$tmp/t$t.json"

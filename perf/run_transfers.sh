@@ -1,9 +1,12 @@
 #!/usr/bin/env bash
-# Runs bench_transfers at 1 and 2 threads; writes perf/baselines/transfers.json
-# (or the file given as $1).   Needs a build in ./build.
+# Runs bench_transfers at 1 and 2 threads; writes build/perf/transfers.json (or the
+# file given as $1; pass perf/baselines/transfers.json to record a new baseline,
+# on a quiet machine). Needs a build in ./build. Compare with the baseline:
+#   python3 perf/compare.py build/perf/transfers.json --baseline perf/baselines/transfers.json --fields FIELDS
 set -euo pipefail
 cd "$(dirname "$0")/.."
-out=${1:-perf/baselines/transfers.json}
+out=${1:-build/perf/transfers.json}
+mkdir -p "$(dirname "$out")"
 tmp=$(mktemp -d)
 for t in 1 2; do
   OMP_NUM_THREADS=$t OMP_PROC_BIND=spread OMP_PLACES=threads build/perf/bench_transfers --out "$tmp/t$t.json"

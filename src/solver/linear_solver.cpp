@@ -11,6 +11,7 @@
 #include <set>
 #include <sstream>
 
+#include "solver/cholmod_direct.hpp"
 #include "solver/solver_error.hpp"
 
 namespace bfemp {
@@ -68,8 +69,15 @@ Teuchos::RCP<const Teuchos::ParameterList> linear_solver_schema() {
       "type", "Cholmod", "Cholmod or KLU2 (direct, 1 MPI rank only) or CG (Belos + Ifpack2)",
       Teuchos::tuple<std::string>("Cholmod", "KLU2", "CG"), pl.get());
   auto& cg = pl->sublist("CG", false, "Belos conjugate gradients with an Ifpack2 preconditioner");
-  cg.set("tolerance", 1e-12, "relative residual |b - A x| / |b| at which CG stops",
+  cg.set("tolerance", 1e-12,
+         "relative residual |b - A x| / |b| at which CG stops (with 'forcing term: adaptive', the "
+         "tightest it is asked for)",
          rcp(new Teuchos::EnhancedNumberValidator<double>(1e-16, 1e-1)));
+  Teuchos::setStringToIntegralParameter<int>(
+      "forcing term", "adaptive",
+      "adaptive: inexact Newton, CG stops at eta_k = min(0.1, |r_k| / |r_0|) (r: the Newton "
+      "residual, floor 'tolerance'); fixed: always at 'tolerance'",
+      Teuchos::tuple<std::string>("adaptive", "fixed"), &cg);
   cg.set("max iterations", 2000, "CG iteration cap; reaching it is an error",
          rcp(new Teuchos::EnhancedNumberValidator<int>(1, 1000000)));
   Teuchos::setStringToIntegralParameter<int>(
@@ -103,13 +111,16 @@ struct LinearSolver::Impl {
   using Prec = Ifpack2::Preconditioner<double, LO, GO, Node>;
   RCP<const Comm> comm;
   RCP<const Matrix> A;
-  RCP<Direct> direct;
+  RCP<Direct> direct;                      // KLU2 (Amesos2)
+  std::unique_ptr<CholmodDirect> cholmod;  // Cholmod: SuiteSparse directly
   bool symbolic_done = false;
   RCP<Prec> prec;
   std::string prec_name;
   ParameterList ifpack2;
   double cg_tol = 1e-12;
+  bool adaptive = true;
   int cg_max_iters = 2000;
+  RCP<Vector> residual;  // direct solves: the residual check, kept across solves
 };
 
 LinearSolver::LinearSolver(const ParameterList& params, const RCP<const Comm>& comm)
@@ -123,12 +134,9 @@ LinearSolver::LinearSolver(const ParameterList& params, const RCP<const Comm>& c
         << comm->getSize() << " ranks. Expected 'CG' under MPI.";
     throw std::invalid_argument(msg.str());
   }
-  if (kind_ == LinearSolverKind::Cholmod && !Amesos2::query("Cholmod"))
-    throw std::invalid_argument(
-        "scene key 'Linear Solver/type' = 'Cholmod': this Trilinos has no Cholmod adapter "
-        "(needs Amesos2_ENABLE_Experimental); expected 'KLU2' or 'CG'");
   const ParameterList& cg = params.sublist("CG");
   impl_->cg_tol = cg.get<double>("tolerance");
+  impl_->adaptive = cg.get<std::string>("forcing term") == "adaptive";
   impl_->cg_max_iters = cg.get<int>("max iterations");
   impl_->prec_name = cg.get<std::string>("preconditioner");
   impl_->ifpack2 = cg.sublist("Ifpack2");
@@ -140,10 +148,11 @@ LinearSolver::LinearSolver(const ParameterList& params, const RCP<const Comm>& c
 LinearSolver::~LinearSolver() = default;
 
 std::string LinearSolver::describe() const {
+  if (kind_ == LinearSolverKind::Cholmod) return "Cholmod (SuiteSparse, symbolic analysis kept per graph)";
   if (kind_ != LinearSolverKind::CG) return std::string("Amesos2 ") + linear_solver_name(kind_);
   std::ostringstream s;
-  s << "Belos CG (tol " << impl_->cg_tol << ", max " << impl_->cg_max_iters << ") + Ifpack2 "
-    << impl_->prec_name;
+  s << "Belos CG (tol " << impl_->cg_tol << (impl_->adaptive ? ", adaptive forcing term" : "") << ", max "
+    << impl_->cg_max_iters << ") + Ifpack2 " << impl_->prec_name;
   return s.str();
 }
 
@@ -164,6 +173,11 @@ void LinearSolver::set_matrix(const RCP<const Matrix>& A) {
     }
     return;
   }
+  if (kind_ == LinearSolverKind::Cholmod) {
+    if (!m.cholmod) m.cholmod = std::make_unique<CholmodDirect>();
+    m.cholmod->set_matrix(A);
+    return;
+  }
   const std::string name = linear_solver_name(kind_);
   m.direct = Amesos2::create<Matrix, MultiVec>(name, A);
   auto p = Teuchos::parameterList("Amesos2");
@@ -172,27 +186,35 @@ void LinearSolver::set_matrix(const RCP<const Matrix>& A) {
   m.symbolic_done = false;
 }
 
-LinearSolveStats LinearSolver::solve(const Vector& b, Vector& x) {
+LinearSolveStats LinearSolver::solve(const Vector& b, Vector& x, double forcing) {
   auto& m = *impl_;
   if (m.A.is_null()) throw std::logic_error("LinearSolver::solve before set_matrix");
   LinearSolveStats stats;
   if (kind_ != LinearSolverKind::CG) {
     try {
-      if (!m.symbolic_done) {
-        m.direct->symbolicFactorization();
-        m.symbolic_done = true;
-        stats.refactored = true;
+      if (m.cholmod) {
+        stats.refactored = m.cholmod->solve(b, x);
+      } else {
+        if (!m.symbolic_done) {
+          m.direct->symbolicFactorization();
+          m.symbolic_done = true;
+          stats.refactored = true;
+        }
+        m.direct->numericFactorization();
+        m.direct->solve(Teuchos::ptr(static_cast<MultiVec*>(&x)),
+                        Teuchos::ptr(static_cast<const MultiVec*>(&b)));
       }
-      m.direct->numericFactorization();
-      m.direct->solve(Teuchos::ptr(static_cast<MultiVec*>(&x)),
-                      Teuchos::ptr(static_cast<const MultiVec*>(&b)));
+    } catch (const SolverError&) {
+      throw;
     } catch (const std::exception& e) {
       throw SolverError(std::string(linear_solver_name(kind_)) + " factorisation/solve failed: " +
                         e.what());
     }
     // One residual check per solve: a direct solver that silently returns a
     // wrong answer is a failure.
-    Vector r(b.getMap());
+    if (m.residual.is_null() || !m.residual->getMap()->isSameAs(*b.getMap()))
+      m.residual = rcp(new Vector(b.getMap()));
+    Vector& r = *m.residual;
     m.A->apply(x, r);
     r.update(1.0, b, -1.0);
     const double bn = b.norm2();
@@ -205,8 +227,9 @@ LinearSolveStats LinearSolver::solve(const Vector& b, Vector& x) {
     return stats;
   }
   if (!m.prec.is_null()) m.prec->compute();
+  const double tol = m.adaptive && forcing > 0 ? std::max(m.cg_tol, std::min(0.1, forcing)) : m.cg_tol;
   auto bp = Teuchos::parameterList();
-  bp->set("Convergence Tolerance", m.cg_tol);
+  bp->set("Convergence Tolerance", tol);
   bp->set("Maximum Iterations", m.cg_max_iters);
   bp->set("Implicit Residual Scaling", "Norm of RHS");
   bp->set("Explicit Residual Scaling", "Norm of RHS");
@@ -228,7 +251,7 @@ LinearSolveStats LinearSolver::solve(const Vector& b, Vector& x) {
   if (ret != Belos::Converged) {
     std::ostringstream msg;
     msg << "CG did not converge: " << stats.iterations << " iterations, relative residual "
-        << stats.achieved_tol << " > tolerance " << m.cg_tol
+        << stats.achieved_tol << " > tolerance " << tol
         << " (raise 'Linear Solver/CG/max iterations' or choose a stronger preconditioner)";
     throw SolverError(msg.str());
   }

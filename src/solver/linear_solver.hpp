@@ -1,5 +1,6 @@
 #pragma once
-// The linear-solver layer: Amesos2 (Cholmod, KLU2) or Belos CG with an
+// The linear-solver layer: Cholmod (SuiteSparse directly, on the matrix's own
+// arrays: solver/cholmod_direct.hpp), KLU2 (Amesos2) or Belos CG with an
 // Ifpack2 preconditioner, configured by the scene's "Linear Solver" sublist.
 #include <Teuchos_ParameterList.hpp>
 #include <Teuchos_RCP.hpp>
@@ -38,7 +39,9 @@ class LinearSolver {
   void set_matrix(const Teuchos::RCP<const Matrix>& A);
   // Solve A x = b with the current values of A. Throws SolverError on a failed
   // factorisation or a Krylov solve that does not reach the tolerance.
-  LinearSolveStats solve(const Vector& b, Vector& x);
+  // `forcing` > 0 (CG with 'forcing term: adaptive'): the relative residual
+  // to reach, clamped to [tolerance, 0.1]; direct solvers ignore it.
+  LinearSolveStats solve(const Vector& b, Vector& x, double forcing = 0.0);
 
   LinearSolverKind kind() const { return kind_; }
   std::string describe() const;
