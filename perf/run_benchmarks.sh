@@ -41,7 +41,8 @@ case "$bench" in
   bench_mpm_newton) bench_json=mpm_newton; bench_name=mpm_newton_iteration ;;
   bench_ccd) bench_json=ccd; bench_name=ccd_queries; [[ -n "$threads" ]] || threads="1" ;;
   bench_assembly) bench_json=assembly; bench_name=assembly ;;
-  *) echo "run_benchmarks.sh: --bench '$bench': expected bench_newton, bench_mpm_newton, bench_ccd or bench_assembly" >&2; exit 2 ;;
+  bench_explicit) bench_json=explicit; bench_name=explicit_step ;;
+  *) echo "run_benchmarks.sh: --bench '$bench': expected bench_newton, bench_mpm_newton, bench_ccd, bench_assembly or bench_explicit" >&2; exit 2 ;;
 esac
 [[ -n "$threads" ]] || threads="1 2"
 [[ -n "$out" ]] || out="$build_dir/perf/$bench_json.json"
