@@ -19,7 +19,8 @@
 // row's node blocks, and entry (i, j) lies at row_map(a dim) + i len(a) + p + j:
 // no search per entry. A block the graph lacks is dropped (the DOF space's
 // graph holds every coupling the terms declare; the derivative tests see a
-// missing one as a wrong entry).
+// missing one as a wrong entry), and counted in `dropped`: the Newton solver
+// then rebuilds the graph from the terms' couplings and assembles again.
 //
 // `atomic` = false is for colored assembly, where no two stencils running at
 // once share a node. Units: whatever the term's energy has (J, or J/m in 2D).
@@ -39,6 +40,9 @@ struct DofSink {
   Kokkos::View<const double*, typename LocalMatrix::memory_space> dx_prescribed;
   double scale = 1.0;
   bool atomic = true;
+  // Counts blocks the graph lacks (when allocated): the DOF space rebuilds
+  // the graph and reassembles instead of dropping them.
+  Kokkos::View<int, typename LocalMatrix::memory_space> dropped;
 
   KOKKOS_INLINE_FUNCTION bool has_matrix() const { return A.values.extent(0) > 0; }
 
@@ -84,7 +88,10 @@ struct DofSink {
         if (prescribed(col)) {
           r -= v * dx_prescribed(col);
         } else {
-          if (pos == -2) pos = block_position(a, b);
+          if (pos == -2) {
+            pos = block_position(a, b);
+            if (pos < 0 && dropped.data()) Kokkos::atomic_increment(&dropped());
+          }
           if (pos >= 0) add(A.values(r0 + i * len + pos + j), v);
         }
       }

@@ -58,7 +58,9 @@ void BarrierTerm<dim>::begin_step(const ParticleStencils<dim>& ps, ConstDofView 
   // Signature of the couplings: each pair with its particle's stencil base
   // node (the stencil's other nodes follow from it while the MPM cells are
   // unchanged; when they change, the MPM term's version forces a rebuild).
-  Kokkos::View<long long* [2], MemSpace> sig_dev("contact_graph_signature", n_pairs_);
+  if (static_cast<LO>(signature_dev_.extent(0)) < n_pairs_)  // grows, not per step
+    signature_dev_ = Kokkos::View<long long* [2], MemSpace>("contact_graph_signature", n_pairs_ + n_pairs_ / 4 + 16);
+  const auto sig_dev = signature_dev_;
   {
     const auto pairs = pairs_;
     const auto nodes = ps.nodes;
@@ -69,11 +71,15 @@ void BarrierTerm<dim>::begin_step(const ParticleStencils<dim>& ps, ConstDofView 
           sig_dev(k, 1) = nodes(pairs(k, 0), 0);
         });
   }
-  auto sig_h = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), sig_dev);
+  auto sig_h = Kokkos::create_mirror_view_and_copy(
+      Kokkos::HostSpace(), Kokkos::subview(sig_dev, std::make_pair(LO(0), n_pairs_), Kokkos::ALL()));
   std::vector<std::pair<long long, long long>> sig(n_pairs_);
   for (LO k = 0; k < n_pairs_; ++k) sig[k] = {sig_h(k, 0), sig_h(k, 1)};
   std::sort(sig.begin(), sig.end());
-  if (sig == signature_) return;  // the graph already holds these pairs
+  // The graph holds exactly these pairs with these stencils only if the last
+  // step did not grow it (grown pairs were recorded with that step's stencils).
+  if (sig == signature_ && !grown_) return;
+  grown_ = false;
   signature_ = std::move(sig);
   ++version_;
   graph_keys_.clear();
@@ -124,6 +130,7 @@ bool BarrierTerm<dim>::update(ConstDofView x) const {
   graph_keys_dev_ = Kokkos::View<long long*, MemSpace>("contact_graph_keys", graph_keys_.size());
   Kokkos::deep_copy(graph_keys_dev_, Kokkos::View<const long long*, Kokkos::HostSpace>(graph_keys_.data(), graph_keys_.size()));
   ++version_;
+  grown_ = true;
   return true;
 }
 

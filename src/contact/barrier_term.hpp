@@ -78,7 +78,9 @@ class BarrierTerm : public EnergyTerm<dim> {
   mutable std::vector<long long> graph_keys_;  // q * n_prims + j, sorted
   mutable Kokkos::View<long long*, MemSpace> graph_keys_dev_;
   std::vector<std::pair<long long, long long>> signature_;  // (pair key, stencil base) at begin_step
+  Kokkos::View<long long* [2], MemSpace> signature_dev_;
   mutable std::uint64_t version_ = 0;
+  mutable bool grown_ = false;  // update() added pairs in this step
   mutable double ccd_min_;
   mutable Timings timings_;
 };

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include <Kokkos_Core.hpp>
+#include <algorithm>
 
 #include "core/types.hpp"
 
@@ -117,7 +118,7 @@ inline DeviceMotions device_motions(const std::vector<PrescribedMotion>& motions
     }
   std::size_t n = 0, ns = 0;
   for (int o : owner) n += o >= 0;
-  for (const auto& m : motions) ns += m.segments.size();
+  for (const auto& m : motions) ns += std::max<std::size_t>(m.segments.size(), 1);
   DeviceMotions d;
   d.node = Kokkos::View<LO*, MemSpace>("fem_motion_node", n);
   d.range = Kokkos::View<int* [2], MemSpace>("fem_motion_range", n);
@@ -128,16 +129,19 @@ inline DeviceMotions device_motions(const std::vector<PrescribedMotion>& motions
   std::size_t k = 0, s0 = 0;
   for (std::size_t mi = 0; mi < motions.size(); ++mi) {
     const auto& m = motions[mi];
+    // A motion without segments holds its nodes (one Fixed segment).
+    const std::size_t nseg = std::max<std::size_t>(m.segments.size(), 1);
+    if (m.segments.empty()) hs(s0) = MotionSegment{};
     for (std::size_t j = 0; j < m.segments.size(); ++j) hs(s0 + j) = m.segments[j];
     for (LO node : m.nodes) {
       if (node < 0 || owner[node] != static_cast<int>(mi)) continue;
       owner[node] = -1;  // once per node
       hn(k) = node;
       hr(k, 0) = static_cast<int>(s0);
-      hr(k, 1) = static_cast<int>(m.segments.size());
+      hr(k, 1) = static_cast<int>(nseg);
       ++k;
     }
-    s0 += m.segments.size();
+    s0 += nseg;
   }
   Kokkos::deep_copy(d.node, hn);
   Kokkos::deep_copy(d.range, hr);

@@ -11,6 +11,9 @@
 
 namespace bfemp {
 
+static_assert(Kokkos::SpaceAccessibility<Kokkos::HostSpace, MemSpace>::accessible,
+              "CholmodDirect hands CHOLMOD the matrix's own arrays: they must be host-accessible");
+
 namespace {
 std::string status_name(int s) {
   switch (s) {

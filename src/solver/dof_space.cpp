@@ -8,7 +8,7 @@
 namespace bfemp {
 
 template <int dim>
-DofSpace<dim>::DofSpace(const Teuchos::RCP<const Comm>& comm) : comm_(comm) {
+DofSpace<dim>::DofSpace(const Teuchos::RCP<const Comm>& comm) : comm_(comm), dropped_("dof_dropped_blocks") {
   fill_params_ = Teuchos::parameterList();
   fill_params_->set("No Nonlocal Changes", true);
 }
@@ -48,6 +48,7 @@ void DofSpace<dim>::rebuild() {
 
 template <int dim>
 void DofSpace<dim>::begin_assembly() {
+  Kokkos::deep_copy(dropped_, 0);
   A_->resumeFill();
   A_->setAllToScalar(0.0);
 }
@@ -63,7 +64,15 @@ Sink<dim> DofSpace<dim>::sink(double scale, DofView grad, DofView rhs, MaskView 
   s.dx_prescribed = dx_prescribed;
   s.scale = scale;
   s.atomic = true;
+  s.dropped = dropped_;
   return s;
+}
+
+template <int dim>
+int DofSpace<dim>::dropped_blocks() const {
+  int n = 0;
+  Kokkos::deep_copy(n, dropped_);
+  return n;
 }
 
 template <int dim>

@@ -58,6 +58,11 @@ class DofSpace {
 
   // Counters since construction, and the time of the last rebuild.
   long graph_builds() const { return graph_builds_; }
+  // Blocks the last assembly found missing from the graph (0 when the cached
+  // graph held every coupling), and how often that forced a rebuild.
+  int dropped_blocks() const;
+  long missing_block_rebuilds() const { return missing_rebuilds_; }
+  void count_missing_block_rebuild() { ++missing_rebuilds_; }
   long graph_reuses() const { return graph_reuses_; }
   double last_graph_build_s() const { return graph_build_s_; }
 
@@ -70,7 +75,8 @@ class DofSpace {
   std::vector<const EnergyTerm<dim>*> terms_;
   std::vector<std::uint64_t> versions_;
   SlipConstraints<dim> slip_;
-  long graph_builds_ = 0, graph_reuses_ = 0;
+  long graph_builds_ = 0, graph_reuses_ = 0, missing_rebuilds_ = 0;
+  Kokkos::View<int, MemSpace> dropped_;
   double graph_build_s_ = 0;
 };
 

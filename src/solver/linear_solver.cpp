@@ -147,6 +147,10 @@ LinearSolver::LinearSolver(const ParameterList& params, const RCP<const Comm>& c
 
 LinearSolver::~LinearSolver() = default;
 
+double LinearSolver::tightest_tolerance() const {
+  return kind_ == LinearSolverKind::CG ? impl_->cg_tol : 0.0;
+}
+
 std::string LinearSolver::describe() const {
   if (kind_ == LinearSolverKind::Cholmod) return "Cholmod (SuiteSparse, symbolic analysis kept per graph)";
   if (kind_ != LinearSolverKind::CG) return std::string("Amesos2 ") + linear_solver_name(kind_);
@@ -228,6 +232,7 @@ LinearSolveStats LinearSolver::solve(const Vector& b, Vector& x, double forcing)
   }
   if (!m.prec.is_null()) m.prec->compute();
   const double tol = m.adaptive && forcing > 0 ? std::max(m.cg_tol, std::min(0.1, forcing)) : m.cg_tol;
+  stats.tolerance = tol;
   auto bp = Teuchos::parameterList();
   bp->set("Convergence Tolerance", tol);
   bp->set("Maximum Iterations", m.cg_max_iters);

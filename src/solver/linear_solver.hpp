@@ -17,6 +17,7 @@ struct LinearSolveStats {
   int iterations = 0;        // Krylov iterations (1 for a direct solve)
   double achieved_tol = 0;   // relative residual reported by the solver
   bool refactored = false;   // a symbolic factorisation happened in this call
+  double tolerance = 0;      // relative residual the solve was asked for (0: direct)
 };
 
 // Schema of the "Linear Solver" sublist with defaults and documentation.
@@ -44,6 +45,8 @@ class LinearSolver {
   LinearSolveStats solve(const Vector& b, Vector& x, double forcing = 0.0);
 
   LinearSolverKind kind() const { return kind_; }
+  // The tolerance of a solve with forcing 0 ('CG/tolerance'; 0 for direct).
+  double tightest_tolerance() const;
   std::string describe() const;
 
  private:

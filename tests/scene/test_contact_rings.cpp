@@ -106,6 +106,11 @@ TEST(ContactRings, MomentumConservedContactStartsOnTimeNoPenetration) {
   const StepReport r_end = sim.diagnostics();
 
   EXPECT_EQ(inside, 0) << "Newton iterates with a particle inside the FEM ring (of " << iterates << ")";
+  // The cached graph always held every coupling the terms assembled (a miss
+  // would have been caught by the sink and forced a rebuild).
+  EXPECT_EQ(sim.newton().dof_space().missing_block_rebuilds(), 0);
+  std::cout << "rings: " << sim.newton().dof_space().graph_builds() << " graph builds, "
+            << sim.newton().dof_space().graph_reuses() << " reuses in " << steps << " steps\n";
   ASSERT_GT(first_pairs, 0) << "no contact in " << steps << " steps";
   EXPECT_GE(first_pairs, n_expected_lo) << "contact began before the analytic time " << t_contact << " s";
   EXPECT_LE(first_pairs, n_expected) << "contact began after the analytic time " << t_contact << " s";

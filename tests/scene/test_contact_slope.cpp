@@ -39,6 +39,7 @@ struct SlopeRun {
   double gap0 = 0;                                            // at t = 0
   double min_distance = std::numeric_limits<double>::infinity();
   long contact_steps = 0, single_friction_solve = 0, max_friction_iters = 0, newton_iters = 0;
+  long missing_block_rebuilds = 0;  // cached graph lacked a coupling (must stay 0)
   double seconds = 0;
 };
 
@@ -83,6 +84,7 @@ SlopeRun run_slope(double mu, int steps) {
     sample(r.time);
   }
   run.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  run.missing_block_rebuilds = sim.newton().dof_space().missing_block_rebuilds();
   return run;
 }
 
@@ -121,6 +123,7 @@ void expect_common(const SlopeRun& r, double mu) {
   EXPECT_GT(r.min_gap, 0.0) << "a particle reached the slope surface";
   EXPECT_GT(r.min_distance, 0.0);
   EXPECT_EQ(r.contact_steps, kSteps) << "the box must stay in contact with the slope at every step";
+  EXPECT_EQ(r.missing_block_rebuilds, 0) << "the cached graph lacked a barrier or friction coupling";
   if (mu > 0) {
     EXPECT_EQ(r.single_friction_solve, 0) << "steps in contact where the outer friction loop ran once";
   }
