@@ -159,24 +159,14 @@ void fem_rows(double h, std::vector<Json>& out, const Teuchos::RCP<const Comm>& 
 }  // namespace
 
 int main(int argc, char** argv) {
-  std::string out_path = "assembly.json";
-  bool quick = false;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    if (a == "--out" && i + 1 < argc) out_path = argv[++i];
-    else if (a == "--quick") quick = true;
-    else {
-      std::cerr << "bench_assembly: unknown option '" << a << "' (expected --out FILE, --quick)\n";
-      return 2;
-    }
-  }
+  BenchArgs args{"assembly.json"};
+  if (const int bad = parse_bench_args(argc, argv, "bench_assembly", args)) return bad;
+  const bool quick = args.quick;
   int provided = 0;
   MPI_Init_thread(&argc, &argv, MPI_THREAD_FUNNELED, &provided);
   int code = 0;
   {
-    Kokkos::InitArguments ka;
-    if (const char* s = std::getenv("OMP_NUM_THREADS")) ka.num_threads = std::atoi(s);
-    Kokkos::ScopeGuard kokkos(ka);
+    Kokkos::ScopeGuard kokkos(kokkos_args_from_env());
     Tpetra::ScopeGuard tpetra(&argc, &argv);
     auto comm = Tpetra::getDefaultComm();
     const int threads = Kokkos::DefaultExecutionSpace::concurrency();
@@ -201,12 +191,7 @@ int main(int argc, char** argv) {
                           .str("material", "neo-Hookean, E = 1e6 Pa, nu = 0.3")
                           .dump(2))
         .raw("results", jarray(results, 4));
-    std::ofstream f(out_path);
-    f << top.dump(0) << "\n";
-    if (!f) {
-      std::cerr << "bench_assembly: cannot write " << out_path << "\n";
-      code = 1;
-    }
+    code = write_json(top, args.out, "bench_assembly");
   }
   MPI_Finalize();
   return code;

@@ -86,22 +86,12 @@ Json run(int refine, int steps) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  std::string out_path = "explicit.json";
-  bool quick = false;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    if (a == "--out" && i + 1 < argc) out_path = argv[++i];
-    else if (a == "--quick") quick = true;
-    else {
-      std::cerr << "bench_explicit: unknown option '" << a << "' (expected --out FILE, --quick)\n";
-      return 2;
-    }
-  }
+  BenchArgs args{"explicit.json"};
+  if (const int bad = parse_bench_args(argc, argv, "bench_explicit", args)) return bad;
+  const bool quick = args.quick;
   int code = 0;
   {
-    Kokkos::InitArguments ka;
-    if (const char* s = std::getenv("OMP_NUM_THREADS")) ka.num_threads = std::atoi(s);
-    Kokkos::ScopeGuard kokkos(ka);
+    Kokkos::ScopeGuard kokkos(kokkos_args_from_env());
     const int threads = Kokkos::DefaultExecutionSpace::concurrency();
     std::cout << "bench_explicit: Kokkos " << Kokkos::DefaultExecutionSpace::name() << ", " << threads
               << " thread(s)\n";
@@ -119,12 +109,7 @@ int main(int argc, char** argv) {
                           .str("sizes", "5 mm, 2.5 mm, 1.25 mm cells; 4 particles per cell")
                           .dump(2))
         .raw("results", jarray(results, 4));
-    std::ofstream f(out_path);
-    f << top.dump(0) << "\n";
-    if (!f) {
-      std::cerr << "bench_explicit: cannot write " << out_path << "\n";
-      code = 1;
-    }
+    code = write_json(top, args.out, "bench_explicit");
   }
   return code;
 }

@@ -3,8 +3,12 @@
 // perf/compare.py reads them): a key -> raw value list in insertion order,
 // numbers with 6 significant digits (non-finite: null), and the process's CPU
 // seconds (user + system, all threads) for the utilisation figures.
+#include <Kokkos_Core.hpp>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <iostream>
 #include <string>
 #include <utility>
 #include <vector>
@@ -70,6 +74,41 @@ inline double cpu_seconds() {
   rusage u{};
   getrusage(RUSAGE_SELF, &u);
   return u.ru_utime.tv_sec + 1e-6 * u.ru_utime.tv_usec + u.ru_stime.tv_sec + 1e-6 * u.ru_stime.tv_usec;
+}
+
+// `--out FILE` and `--quick`, the options of the kernel benchmarks. Returns
+// 0, or 2 after naming an unknown option.
+struct BenchArgs {
+  std::string out;
+  bool quick = false;
+};
+inline int parse_bench_args(int argc, char** argv, const char* name, BenchArgs& args) {
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    if (a == "--out" && i + 1 < argc) args.out = argv[++i];
+    else if (a == "--quick") args.quick = true;
+    else {
+      std::cerr << name << ": unknown option '" << a << "' (expected --out FILE, --quick)\n";
+      return 2;
+    }
+  }
+  return 0;
+}
+
+// Kokkos with OMP_NUM_THREADS threads (what run_benchmarks.sh sets).
+inline Kokkos::InitArguments kokkos_args_from_env() {
+  Kokkos::InitArguments ka;
+  if (const char* s = std::getenv("OMP_NUM_THREADS")) ka.num_threads = std::atoi(s);
+  return ka;
+}
+
+// Writes the top-level object; 0, or 1 after saying the file failed.
+inline int write_json(const Json& top, const std::string& path, const char* name) {
+  std::ofstream f(path);
+  f << top.dump(0) << "\n";
+  if (f) return 0;
+  std::cerr << name << ": cannot write " << path << "\n";
+  return 1;
 }
 
 }  // namespace bfemp::bench

@@ -260,9 +260,7 @@ int main(int argc, char** argv) {
   MPI_Init_thread(&argc, &argv, MPI_THREAD_FUNNELED, &provided);
   int code = 0;
   {
-    Kokkos::InitArguments ka;
-    if (const char* s = std::getenv("OMP_NUM_THREADS")) ka.num_threads = std::atoi(s);
-    Kokkos::ScopeGuard kokkos(ka);
+    Kokkos::ScopeGuard kokkos(kokkos_args_from_env());
     Tpetra::ScopeGuard tpetra(&argc, &argv);
     auto comm = Tpetra::getDefaultComm();
     const int threads = Kokkos::DefaultExecutionSpace::concurrency();

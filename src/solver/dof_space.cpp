@@ -56,14 +56,7 @@ void DofSpace<dim>::begin_assembly() {
 template <int dim>
 Sink<dim> DofSpace<dim>::sink(double scale, DofView grad, DofView rhs, MaskView prescribed,
                               ConstDofView dx_prescribed) const {
-  Sink<dim> s;
-  s.A = A_->getLocalMatrixDevice();
-  s.grad = grad;
-  s.rhs = rhs;
-  s.prescribed = prescribed;
-  s.dx_prescribed = dx_prescribed;
-  s.scale = scale;
-  s.atomic = true;
+  Sink<dim> s = make_sink<dim>(A_->getLocalMatrixDevice(), scale, grad, rhs, prescribed, dx_prescribed);
   s.dropped = dropped_;
   return s;
 }
