@@ -123,15 +123,20 @@ KOKKOS_INLINE_FUNCTION void symmetric_from_lower(SquareMat<n>& H) {
     for (int r = 0; r < c; ++r) H(r, c) = H(c, r);
 }
 
-// scale * (gradient, PSD-projected Hessian) of every stencil into the sink,
-// which eliminates prescribed DOFs (kernels/dof_sink.hpp). Stencils run in
-// parallel with atomic adds; see MpmElasticityTerm for the colored version.
+// scale * (gradient, PSD-projected Hessian) of stencils into the sink, which
+// eliminates prescribed DOFs (kernels/dof_sink.hpp): stencils order(k), k in
+// [k0, k1) (all stencils, in index order, when `order` is empty), in
+// parallel; the sink's `atomic` flag says whether they may share nodes.
 template <int dim, int nv, class Sink>
 void deformation_assemble(const DeformationStencils<dim, nv>& s, Kokkos::View<const double*, MemSpace> x,
-                          const Sink& sink, bool project = true) {
+                          const Sink& sink, bool project = true, Kokkos::View<const LO*, MemSpace> order = {},
+                          LO k0 = 0, LO k1 = -1) {
   constexpr int nd = nv * dim;
+  const bool ordered = order.extent(0) > 0;
+  if (k1 < 0) k1 = ordered ? static_cast<LO>(order.extent(0)) : s.size();
   Kokkos::parallel_for(
-      "deformation_assemble", Kokkos::RangePolicy<ExecSpace>(0, s.size()), KOKKOS_LAMBDA(const LO q) {
+      "deformation_assemble", Kokkos::RangePolicy<ExecSpace>(k0, k1), KOKKOS_LAMBDA(const LO k) {
+        const LO q = ordered ? order(k) : k;
         Eigen::Matrix<double, nd, 1> gl = Eigen::Matrix<double, nd, 1>::Zero();
         SquareMat<nd> Hl = SquareMat<nd>::Zero();
         deformation_local_add<dim, nv>(s, x, q, project, gl, Hl);

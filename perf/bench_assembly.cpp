@@ -5,7 +5,9 @@
 //   mpm_per_particle  the same stencils one particle at a time with atomics
 //                     (the generic deformation_assemble path), per particle;
 //   fem               FEM simplices (triangles / tetrahedra): gradient +
-//                     projected (d+1)d square Hessian into the matrix, per element;
+//                     projected (d+1)d square Hessian into the matrix, per
+//                     element, colored without atomics (what the simulation runs);
+//   fem_atomic        the same, all elements at once with atomic adds;
 // beside a STREAM-style copy (GB/s) measured in the same run, so that a slow
 // machine shows as a slow copy too. Each figure is the best of 5 calls on a
 // matrix from the DOF space (solver/dof_space.hpp), as the Newton solver
@@ -153,6 +155,9 @@ void fem_rows(double h, std::vector<Json>& out, const Teuchos::RCP<const Comm>& 
   DofSpace<dim> space(comm);
   space.set_structure(mesh.num_nodes(), {&term});
   const double goal = dim == 2 ? 1000.0 : 2500.0;  // 2D: not in the table
+  out.push_back(row(dim, "fem_atomic", mesh.num_cells(),
+                    time_assembly<dim>(space, [&](const Sink<dim>& s) { term.assemble(x, s); }), goal));
+  term.set_coloring(color_stencils<dim + 1>(mesh.elements.nodes, mesh.num_nodes()));  // as the simulation runs it
   out.push_back(row(dim, "fem", mesh.num_cells(), time_assembly<dim>(space, [&](const Sink<dim>& s) { term.assemble(x, s); }), goal));
 }
 

@@ -289,7 +289,10 @@ template <int dim>
 typename BarrierTerm<dim>::ActivePairs BarrierTerm<dim>::active_pairs(ConstDofView x) const {
   find_pairs(x, ConstDofView());
   ActivePairs out;
-  Kokkos::View<double*, MemSpace> dist("contact_pair_distance", n_pairs_);
+  // Buffers grow and are kept (not per call): capacity >= count.
+  if (static_cast<LO>(pair_distance_.extent(0)) < n_pairs_)
+    pair_distance_ = Kokkos::View<double*, MemSpace>("contact_pair_distance", n_pairs_ + n_pairs_ / 4 + 16);
+  const auto dist = pair_distance_;
   const auto pairs = pairs_;
   const auto prims = prims_;
   const auto ps = ps_;
@@ -304,9 +307,15 @@ typename BarrierTerm<dim>::ActivePairs BarrierTerm<dim>::active_pairs(ConstDofVi
       "contact_active_count", Kokkos::RangePolicy<ExecSpace>(0, n_pairs_),
       KOKKOS_LAMBDA(const LO k, LO& acc) { acc += dist(k) < dhat ? 1 : 0; }, count);
   out.count = count;
-  out.pairs = Kokkos::View<LO* [2], MemSpace>("contact_active_pairs", count);
-  out.distance = Kokkos::View<double*, MemSpace>("contact_active_distance", count);
-  out.lambda = Kokkos::View<double*, MemSpace>("contact_active_lambda", count);
+  if (static_cast<LO>(active_.distance.extent(0)) < count) {
+    const LO cap = count + count / 4 + 16;
+    active_.pairs = Kokkos::View<LO* [2], MemSpace>("contact_active_pairs", cap);
+    active_.distance = Kokkos::View<double*, MemSpace>("contact_active_distance", cap);
+    active_.lambda = Kokkos::View<double*, MemSpace>("contact_active_lambda", cap);
+  }
+  out.pairs = active_.pairs;
+  out.distance = active_.distance;
+  out.lambda = active_.lambda;
   auto op = out.pairs;
   auto od = out.distance;
   auto ol = out.lambda;

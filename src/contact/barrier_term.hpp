@@ -40,6 +40,8 @@ class BarrierTerm : public EnergyTerm<dim> {
 
   // Pairs (particle, primitive) near x with d < dhat: their distance and the
   // normal force magnitude lambda = -omega c b'(d) (N in 3D, N/m in 2D).
+  // The first `count` entries are valid (the Views are the term's own
+  // buffers, capacity >= count, reused by the next call).
   struct ActivePairs {
     Kokkos::View<LO* [2], MemSpace> pairs;
     Kokkos::View<double*, MemSpace> distance, lambda;
@@ -79,8 +81,10 @@ class BarrierTerm : public EnergyTerm<dim> {
   mutable Kokkos::View<long long*, MemSpace> graph_keys_dev_;
   std::vector<std::pair<long long, long long>> signature_;  // (pair key, stencil base) at begin_step
   Kokkos::View<long long* [2], MemSpace> signature_dev_;
+  mutable Kokkos::View<double*, MemSpace> pair_distance_;
   mutable std::uint64_t version_ = 0;
   mutable bool grown_ = false;  // update() added pairs in this step
+  mutable ActivePairs active_;  // buffers of active_pairs()
   mutable double ccd_min_;
   mutable Timings timings_;
 };

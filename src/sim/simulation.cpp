@@ -34,6 +34,7 @@ Simulation<dim>::Simulation(SimulationSetup<dim> setup, const Teuchos::RCP<const
   if (!(setup_.dt > 0))
     throw std::invalid_argument("time step dt = " + std::to_string(setup_.dt) + ": expected dt > 0");
   elasticity_ = std::make_unique<DeformationTerm<dim, dim + 1>>("fem elasticity", mesh_.elements);
+  if (mesh_.num_cells() > 0) elasticity_->set_coloring(color_stencils<dim + 1>(mesh_.elements.nodes, mesh_.num_nodes()));
   if (setup_.mpm) mpm_ = std::make_unique<MpmBodies<dim>>(*setup_.mpm, mesh_.elements.materials);
   newton_ = std::make_unique<NewtonSolver<dim>>(comm, setup_.linear_solver, setup_.newton);
   sys_ = std::make_unique<System>();

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "kernels/deformation_energy.hpp"
+#include "solver/stencil_coloring.hpp"
 #include "kernels/dof_sink.hpp"
 #include "solver/tpetra_types.hpp"
 
@@ -86,9 +87,22 @@ class DeformationTerm : public EnergyTerm<dim> {
   void gradient(ConstDofView x, double scale, DofView grad) const override {
     deformation_gradient(s_, x, scale, grad);
   }
+  // Colored (set_coloring): color by color, without atomics; otherwise all
+  // stencils at once with atomic adds.
   void assemble(ConstDofView x, const Sink<dim>& sink) const override {
-    deformation_assemble(s_, x, sink, project_);
+    if (coloring_.colors() == 0) {
+      deformation_assemble(s_, x, sink, project_);
+      return;
+    }
+    Sink<dim> plain = sink;
+    plain.atomic = false;  // the stencils of one color share no node
+    for (int c = 0; c < coloring_.colors(); ++c)
+      deformation_assemble(s_, x, plain, project_, coloring_.order, coloring_.color_start[c],
+                           coloring_.color_start[c + 1]);
   }
+  // Stencils grouped so that none of one color shares a node (solver/stencil_coloring.hpp).
+  void set_coloring(StencilColoring c) { coloring_ = std::move(c); }
+  const StencilColoring& coloring() const { return coloring_; }
   // false: assemble the exact (unprojected) Hessian, for derivative tests.
   void set_projection(bool project) { project_ = project; }
   bool projection() const { return project_; }
@@ -98,6 +112,7 @@ class DeformationTerm : public EnergyTerm<dim> {
   std::string name_;
   DeformationStencils<dim, nv> s_;
   bool project_ = true;
+  StencilColoring coloring_;
 };
 
 }  // namespace bfemp

@@ -55,8 +55,18 @@ strict=(--strict)  # the particle grid's cells (fixed in the writer) are checked
 png=$work/paraview_check.png
 if [ -n "$xvfb_run" ]; then
   echo "== pvpython under xvfb-run: $check"
-  "$xvfb_run" -a -s "-screen 0 1280x1024x24" "$pvpython" "$check" "$work/run" --screenshot "$png" "${strict[@]}"
-  rc=$?
+  "$xvfb_run" -a -s "-screen 0 1280x1024x24" "$pvpython" "$check" "$work/run" --screenshot "$png" "${strict[@]}" \
+    2>&1 | tee "$work/pvpython.log"
+  rc=${PIPESTATUS[0]}
+  # xvfb-run -a picks :99 upward by lock files; two test runs starting at once
+  # can both take the same number and one gets "bad X server connection".
+  # That is the harness, not the output: retry once on a random server number.
+  if [ "$rc" -ne 0 ] && grep -q "bad X server connection" "$work/pvpython.log"; then
+    server=$((200 + RANDOM % 600))
+    echo "== X server collision; retrying on :$server"
+    "$xvfb_run" -n "$server" -s "-screen 0 1280x1024x24" "$pvpython" "$check" "$work/run" --screenshot "$png" "${strict[@]}"
+    rc=$?
+  fi
 elif [ -n "${DISPLAY:-}" ]; then
   echo "== pvpython on DISPLAY=$DISPLAY (no xvfb-run): $check"
   "$pvpython" "$check" "$work/run" --screenshot "$png" "${strict[@]}"

@@ -140,7 +140,20 @@ void fem_case() {
   const Dense ref = dense_reference<dim, dim + 1>(mesh.elements, x, nd, scale, pres, dxp);
   const Dense got = assemble_with<dim>(space, nd, scale, pres, dxp, [&](const Sink<dim>& s) { term.assemble(x, s); });
   expect_same(got, ref, nd, "FEM");
-  std::cout << "  FEM " << dim << "D: " << mesh.num_cells() << " elements, " << nd << " DOFs\n";
+  // Colored: no two elements of a color share a node; same matrix.
+  term.set_coloring(color_stencils<dim + 1>(mesh.elements.nodes, n));
+  const auto& col = term.coloring();
+  ASSERT_GT(col.colors(), 1);
+  for (int c = 0; c < col.colors(); ++c) {
+    std::vector<int> seen(n, 0);
+    for (LO k = col.color_start[c]; k < col.color_start[c + 1]; ++k)
+      for (int a = 0; a <= dim; ++a) EXPECT_EQ(seen[mesh.elements.nodes(col.order(k), a)]++, 0) << "color " << c;
+  }
+  const Dense colored =
+      assemble_with<dim>(space, nd, scale, pres, dxp, [&](const Sink<dim>& s) { term.assemble(x, s); });
+  expect_same(colored, ref, nd, "FEM colored");
+  std::cout << "  FEM " << dim << "D: " << mesh.num_cells() << " elements in " << col.colors() << " colors, " << nd
+            << " DOFs\n";
 }
 
 template <int dim>
