@@ -55,6 +55,10 @@
 // only), 16.9 % (both); LR + XPIC(5) 13.8 % (tol only), 17.5 % (penalty
 // only), 17.4 % (both); the last failure is at the block edge near 16.5 %,
 // where single-material XPIC(5) also goes unstable (not diagnosed).
+// Both knobs as defaults: LR + FLIP error 0.707 % -> 0.160 % (penalty only
+// 0.393 %, tolerance only 0.959 %), B1(a) still passes, but
+// ExplicitStepper.FrictionlessCollision3DConservesMomentum then sees no contact
+// in 300 steps (penalty 1e-3 in 3D, not diagnosed): so the defaults stay the paper's.
 #ifndef B1_END_STRAIN
 #define B1_END_STRAIN 0.20
 #endif
