@@ -445,7 +445,7 @@ struct StepKernels {
                   bmin = xn - R;
                 }
               });
-              d = bmin - amax;
+              d = bmin - amax - cfg.lr.contact_tolerance * g.dx;
             } else {
               Vec<dim> ga = Vec<dim>::Zero(), gb = Vec<dim>::Zero(), xa = Vec<dim>::Zero(), xb = Vec<dim>::Zero();
               double ma = 0, mb = 0;
