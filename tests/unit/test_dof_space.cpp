@@ -337,3 +337,45 @@ TEST(DofSpace, ParticleOrderChangesOnlyRoundOff) {
   EXPECT_LT(worst, 1e-12 * scale) << "reversed particle order changed the run by " << worst;
   std::cout << "  reversed order: largest difference " << worst << " m (positions, dt * velocities)\n";
 }
+
+// The constraint rows the DOF space writes (end_assembly): a prescribed DOF's
+// row is the identity with rhs = dx_prescribed, and no free row keeps an entry
+// in a prescribed column (the sink moved it to the rhs).
+TEST(DofSpace, EndAssemblyWritesIdentityRowsForPrescribedDofs) {
+  auto setup = block_setup<2>(0.25, 1e5, 0.3);
+  FemMesh<2> mesh = build_fem_mesh<2>(setup.bodies, setup.materials);
+  DeformationTerm<2, 3> term("fem", mesh.elements);
+  const LO n = mesh.num_nodes();
+  const std::size_t nd = static_cast<std::size_t>(n) * 2;
+  Kokkos::View<double*, MemSpace> x("x", nd), grad("grad", nd), rhs("rhs", nd), dx("dxp", nd);
+  Kokkos::View<int*, MemSpace> p("pres", nd);
+  for (std::size_t i = 0; i < nd; ++i) x(i) = mesh.rest_position(i) * (i % 2 ? 1.03 : 0.97);
+  std::vector<double> dxp;
+  const auto pres = some_prescribed(nd, dxp, 13);
+  for (std::size_t i = 0; i < nd; ++i) {
+    p(i) = pres[i];
+    dx(i) = dxp[i];
+  }
+  DofSpace<2> space(comm());
+  ASSERT_TRUE(space.set_structure(n, {&term}));
+  space.begin_assembly();
+  term.assemble(x, space.sink(0.5, grad, rhs, p, dx));
+  space.end_assembly(p, dx, rhs);
+  auto A = space.matrix();
+  long prescribed_rows = 0;
+  for (std::size_t i = 0; i < nd; ++i) {
+    typename Matrix::local_inds_host_view_type cols;
+    typename Matrix::values_host_view_type vals;
+    A->getLocalRowView(i, cols, vals);
+    for (std::size_t k = 0; k < cols.extent(0); ++k) {
+      const std::size_t j = cols(k);
+      if (pres[i]) EXPECT_EQ(vals(k), j == i ? 1.0 : 0.0) << "prescribed row " << i << ", column " << j;
+      else if (pres[j]) EXPECT_EQ(vals(k), 0.0) << "free row " << i << " keeps prescribed column " << j;
+    }
+    if (pres[i]) {
+      ++prescribed_rows;
+      EXPECT_EQ(rhs(i), dxp[i]) << "rhs of prescribed DOF " << i;
+    }
+  }
+  EXPECT_GT(prescribed_rows, 10);
+}
