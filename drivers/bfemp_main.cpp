@@ -1,6 +1,8 @@
 // The bfemp command line:
 //   bfemp run SCENE [--set key=value ...] [--output DIR]
 //   bfemp restart DIR [--set key=value ...] [--output DIR2]
+//   bfemp probe DIR SPEC [SPEC ...]       observables of a finished run
+//   bfemp sweep SCENE --vary KEY=v1,v2 --probe SPEC [...]   (see --help)
 // Exit codes: 0 done, 2 bad input, 3 solver failure, 130 / 143 stopped by
 // SIGINT / SIGTERM after writing a checkpoint, 1 anything else.
 #include <CLI/CLI.hpp>
@@ -15,9 +17,11 @@
 
 #include "io/checkpoint.hpp"
 #include "io/scene.hpp"
+#include "probes/probes.hpp"
 #include "sim/interrupt.hpp"
 #include "sim/run.hpp"
 #include "solver/solver_error.hpp"
+#include "sweep/sweep.hpp"
 
 namespace {
 
@@ -52,7 +56,32 @@ int main(int argc, char** argv) {
                       "Linear Solver/*, Contact/friction iterations, Contact/check iterates)");
   restart->add_option("--output,-o", restart_output,
                       "write the continuation into a new directory (default: append to DIR)");
+  std::string probe_dir;
+  std::vector<std::string> probe_specs;
+  auto* probe = app.add_subcommand("probe", "print observables of a run from its diagnostics.csv");
+  probe->add_option("dir", probe_dir, "output directory of a run (or its diagnostics.csv)")->required();
+  probe->add_option("specs", probe_specs, "probes: NAME[:key=value,...] (bfemp sweep --help lists them)")
+      ->required();
+  bfemp::SweepOptions sw;
+  std::string probe_help = "probes (NAME:key=value,...):";
+  for (const auto& p : bfemp::probe_list())
+    probe_help += "\n  " + p.name + (p.args.empty() ? "" : ":" + p.args) + "\n      " + p.help;
+  auto* sweep = app.add_subcommand(
+      "sweep", "runs a scene over a grid of key values and measures a probe against a reference per run");
+  sweep->footer(probe_help);
+  sweep->add_option("scene", sw.scene, "scene file (YAML)")->required();
+  sweep->add_option("--vary", sw.vary, "KEY=v1,v2,... (repeatable; the grid is their product; K1&K2=a1&b1,a2&b2 varies keys together)")->required();
+  sweep->add_option("--set", sw.sets, "override a scene key in every run: path/to/key=value (repeatable)");
+  sweep->add_option("--probe", sw.probes, "NAME[:key=value,...] (repeatable; the first gives the error)")
+      ->required();
+  auto* ref = sweep->add_option("--reference", sw.reference, "the exact value of the first probe");
+  sweep->add_option("--reference-run", sw.reference_run,
+                    "KEY=v for an extra reference run (repeatable); default reference: the last run")
+      ->excludes(ref);
+  sweep->add_option("--out,-o", sw.out, "output directory (default: sweep)");
   CLI11_PARSE(app, argc, argv);
+  sw.has_reference = ref->count() > 0;
+  sw.plot_script = std::string(BFEMP_SOURCE_DIR) + "/scripts/plot_sweep.py";
 
   int provided = 0;
   MPI_Init_thread(&argc, &argv, MPI_THREAD_FUNNELED, &provided);
@@ -65,14 +94,20 @@ int main(int argc, char** argv) {
     auto comm = Tpetra::getDefaultComm();
     const bool root = comm->getRank() == 0;
     std::ostream& log = std::cout;
-    if (root)
+    if (root && !probe->parsed())
       log << "bfemp: Kokkos " << Kokkos::DefaultExecutionSpace::name() << ", "
           << Kokkos::DefaultExecutionSpace::concurrency() << " thread(s); MPI ranks "
           << comm->getSize() << "\n";
     try {
       bfemp::RunOptions opt;
       opt.handle_signals = true;
-      if (run->parsed()) {
+      if (probe->parsed()) {
+        const bfemp::RunTable t = bfemp::RunTable::read_csv(probe_dir);
+        std::cout.precision(12);
+        for (const auto& spec : probe_specs) std::cout << spec << " = " << bfemp::evaluate_probe(spec, t) << "\n";
+      } else if (sweep->parsed()) {
+        bfemp::run_sweep(sw, comm, log);
+      } else if (run->parsed()) {
         opt.scene_source = read_text(scene_path);
         opt.overrides = sets;
         const bfemp::Scene scene = bfemp::load_scene(scene_path, sets);

@@ -37,11 +37,15 @@ KOKKOS_INLINE_FUNCTION Mat<dim> stencil_F(const DeformationStencils<dim, nv>& s,
   return F;
 }
 
+// sum over stencils q in [k0, k1) (k1 < 0: to the end) of V_q psi(F_q).
 template <int dim, int nv>
-double deformation_energy(const DeformationStencils<dim, nv>& s, Kokkos::View<const double*, MemSpace> x) {
+double deformation_energy(const DeformationStencils<dim, nv>& s, Kokkos::View<const double*, MemSpace> x,
+                          LO k0 = 0, LO k1 = -1) {
   double total = 0;
+  if (k1 < 0) k1 = s.size();
+  if (k1 <= k0) return 0.0;
   Kokkos::parallel_reduce(
-      "deformation_energy", Kokkos::RangePolicy<ExecSpace>(0, s.size()),
+      "deformation_energy", Kokkos::RangePolicy<ExecSpace>(k0, k1),
       KOKKOS_LAMBDA(const LO q, double& acc) {
         acc += s.volume(q) * material_energy<dim>(s.materials(s.material(q)), stencil_F(s, x, q));
       },

@@ -132,6 +132,28 @@ typename Contact<dim>::Report Contact<dim>::report(ConstDofView x, LO n_fem_node
         KOKKOS_LAMBDA(const LO n, double& acc) { acc -= g(n * dim + c); }, f[c]);
   r.force = {f[0], f[1], f[2]};
   const std::size_t nq = static_cast<std::size_t>(ps_.size()) * dim;
+  {
+    if (report_xp_.extent(0) != nq) report_xp_ = Kokkos::View<double*, MemSpace>("contact_report_xp", nq);
+    interpolate_particles(ps_, x, report_xp_);
+    const auto xp = report_xp_;
+    const auto pr = act.pairs;
+    const auto pbody = barrier_->primitives().body;
+    const int fb = params_.force_body;
+    for (int c = 0; c < dim; ++c) {
+      double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+      Kokkos::parallel_reduce(
+          "contact_extent", Kokkos::RangePolicy<ExecSpace>(0, act.count),
+          KOKKOS_LAMBDA(const LO k, double& a, double& b) {
+            if (fb >= 0 && pbody(pr(k, 1)) != fb) return;
+            const double v = xp(pr(k, 0) * dim + c);
+            a = v < a ? v : a;
+            b = v > b ? v : b;
+          },
+          Kokkos::Min<double>(lo), Kokkos::Max<double>(hi));
+      r.extent_lo[c] = lo;
+      r.extent_hi[c] = hi;
+    }
+  }
   if (particle_force_.extent(0) != nq) particle_force_ = Kokkos::View<double*, MemSpace>("contact_particle_force", nq);
   barrier_->particle_forces(x, particle_force_);
   if (friction_) friction_->add_particle_forces(x, particle_force_);

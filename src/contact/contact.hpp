@@ -54,6 +54,10 @@ class Contact {
     double barrier_energy = 0;      // B(x), J (J/m in 2D)
     double ccd_alpha_min = 0;       // smallest CCD step bound this step (inf: none)
     std::array<double, 3> force{};  // contact force on the FEM body (or all)
+    // Bounding box of the particles (at x) in pairs with d < dhat against
+    // the reported FEM body's boundary (or any); lo > hi when there is none.
+    // Half its width is the Hertz contact half-width of VALIDATION A3.
+    std::array<double, 3> extent_lo{0, 0, 0}, extent_hi{0, 0, 0};
     typename BarrierTerm<dim>::Timings timings;  // this step's contact seconds
   };
   // At the step's solution x (system DOFs; the first n_fem_nodes are FEM).
@@ -68,7 +72,7 @@ class Contact {
   std::unique_ptr<BarrierTerm<dim>> barrier_;
   std::unique_ptr<FrictionTerm<dim>> friction_;
   ParticleStencils<dim> ps_;
-  Kokkos::View<double*, MemSpace> grad_, particle_force_;
+  Kokkos::View<double*, MemSpace> grad_, particle_force_, report_xp_;
   mutable SpatialHash<dim> element_hash_;
   mutable Boxes<dim> element_boxes_, point_boxes_;
   mutable Kokkos::View<LO* [2], MemSpace> inside_pairs_;

@@ -2,6 +2,7 @@
 
 #include <Teuchos_YamlParameterListHelpers.hpp>
 #include <filesystem>
+#include <iterator>
 #include <set>
 #include <sstream>
 
@@ -9,23 +10,39 @@
 
 namespace bfemp {
 
-const std::vector<std::string>& diagnostics_columns() {
-  static const std::vector<std::string> cols = {
+std::vector<std::string> diagnostics_columns(const std::vector<std::string>& bodies) {
+  std::vector<std::string> cols = {
       "step", "time", "dt", "kinetic", "elastic", "potential", "total_energy", "momentum_x",
       "momentum_y", "momentum_z", "newton_iters", "linear_iters", "min_J", "assembly_s", "solve_s",
       "step_s", "active_grid_nodes", "contact_pairs", "min_distance", "barrier_energy", "friction_iters",
-      "ccd_alpha_min", "contact_force_x", "contact_force_y", "contact_force_z"};
+      "ccd_alpha_min", "contact_force_x", "contact_force_y", "contact_force_z", "contact_lo_x",
+      "contact_lo_y", "contact_lo_z", "contact_hi_x", "contact_hi_y", "contact_hi_z"};
+  for (const std::string& b : bodies)
+    for (const char* f : body_column_fields()) cols.push_back(b + "." + f);
   return cols;
 }
 
+const std::vector<const char*>& body_column_fields() {
+  static const std::vector<const char*> f = {"mass",  "com_x", "com_y",   "com_z",  "vel_x",
+                                             "vel_y", "vel_z", "kinetic", "elastic"};
+  return f;
+}
+
 std::vector<double> diagnostics_row(const StepReport& r) {
-  return {static_cast<double>(r.step), r.time, r.dt, r.kinetic, r.elastic, r.potential,
+  std::vector<double> row = {static_cast<double>(r.step), r.time, r.dt, r.kinetic, r.elastic, r.potential,
           r.total_energy(), r.momentum[0], r.momentum[1], r.momentum[2],
           static_cast<double>(r.newton.iterations), static_cast<double>(r.newton.linear_iterations),
           r.min_J, r.newton.assembly_s, r.newton.solve_s, r.step_s, static_cast<double>(r.active_grid_nodes),
           static_cast<double>(r.contact_pairs), r.min_distance, r.barrier_energy,
           static_cast<double>(r.friction_iters), r.ccd_alpha_min, r.contact_force[0], r.contact_force[1],
-          r.contact_force[2]};
+          r.contact_force[2], r.contact_lo[0], r.contact_lo[1], r.contact_lo[2], r.contact_hi[0],
+          r.contact_hi[1], r.contact_hi[2]};
+  for (const BodyReport& b : r.bodies) {
+    const double v[] = {b.mass,        b.com[0],      b.com[1], b.com[2], b.velocity[0],
+                        b.velocity[1], b.velocity[2], b.kinetic, b.elastic};
+    row.insert(row.end(), std::begin(v), std::end(v));
+  }
+  return row;
 }
 
 namespace {
@@ -43,13 +60,13 @@ RunOutput<dim>::RunOutput(const std::string& dir, const Scene& scene, const Simu
                                       "friction_iters"};
   if (resume) {
     h5_ = std::make_unique<Hdf5FrameWriter>(dir + "/bfemp.h5", resume->frames);
-    csv_ = std::make_unique<DiagnosticsCsv>(dir + "/diagnostics.csv", diagnostics_columns(), ints, resume->step);
+    csv_ = std::make_unique<DiagnosticsCsv>(dir + "/diagnostics.csv", diagnostics_columns(sim.body_names()), ints, resume->step);
     for (int i = 0; i < resume->frames; ++i) xdmf_.add_frame(xdmf_frame(sim, i, h5_->frame_time(i)), false);
     xdmf_.write();
     frame_ = resume->frames;
   } else {
     h5_ = std::make_unique<Hdf5FrameWriter>(dir + "/bfemp.h5");
-    csv_ = std::make_unique<DiagnosticsCsv>(dir + "/diagnostics.csv", diagnostics_columns(), ints);
+    csv_ = std::make_unique<DiagnosticsCsv>(dir + "/diagnostics.csv", diagnostics_columns(sim.body_names()), ints);
   }
   std::ostringstream yaml;
   yaml << std::showpoint;

@@ -16,8 +16,12 @@
 
 namespace bfemp {
 
-// Column order of diagnostics.csv.
-const std::vector<std::string>& diagnostics_columns();
+// Column order of diagnostics.csv: the step's totals, then for each body (in
+// Simulation::body_names() order) "<body>.<field>" for the fields of
+// body_column_fields() (mass, centre of mass, its velocity, kinetic and
+// elastic energy).
+std::vector<std::string> diagnostics_columns(const std::vector<std::string>& bodies);
+const std::vector<const char*>& body_column_fields();
 std::vector<double> diagnostics_row(const StepReport& r);
 
 // Restart into the run's own directory: keep `frames` frames and the

@@ -77,6 +77,12 @@ void check_materials(const ParameterList& raw) {
             "the name of an entry of Materials");
     }
   }
+  // Body names label diagnostics.csv columns ("<body>.com_x"): one name, one body.
+  const auto& fem_bodies = raw.sublist("FEM Bodies");
+  for (auto it = mpm_bodies.begin(); it != mpm_bodies.end(); ++it)
+    if (fem_bodies.isSublist(mpm_bodies.name(it)))
+      bad("MPM Bodies/" + mpm_bodies.name(it), "'" + mpm_bodies.name(it) + "'",
+          "a body name not used by an FEM body too");
 }
 
 void check_mpm(const ParameterList& raw, int dim) {

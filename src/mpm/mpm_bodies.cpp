@@ -161,15 +161,17 @@ void MpmBodies<dim>::end_step(Kokkos::View<const double*, MemSpace> x_new, Kokko
 }
 
 template <int dim>
-typename MpmBodies<dim>::Diagnostics MpmBodies<dim>::diagnostics(const std::array<double, 3>& g) const {
+typename MpmBodies<dim>::Diagnostics MpmBodies<dim>::diagnostics(const std::array<double, 3>& g, int body) const {
   const auto& p = setup_.particles;
   auto mats = materials_;
   const bool apic = setup_.scheme == TransferScheme::APIC;
   const double D = setup_.grid.dx * setup_.grid.dx / 4.0;
-  double ke = 0, el = 0, pe = 0, p0 = 0, p1 = 0, p2 = 0, L = 0;
+  double ke = 0, el = 0, pe = 0, p0 = 0, p1 = 0, p2 = 0, L = 0, M = 0, X0 = 0, X1 = 0, X2 = 0;
   Kokkos::parallel_reduce(
       "mpm_diagnostics", Kokkos::RangePolicy<ExecSpace>(0, p.size()),
-      KOKKOS_LAMBDA(const LO q, double& k, double& e, double& u, double& q0, double& q1, double& q2, double& l) {
+      KOKKOS_LAMBDA(const LO q, double& k, double& e, double& u, double& q0, double& q1, double& q2, double& l,
+                    double& mm, double& x0, double& x1, double& x2) {
+        if (body >= 0 && p.body(q) != body) return;
         const double m = p.mass(q);
         Mat<dim> F;
         for (int i = 0; i < dim; ++i)
@@ -184,12 +186,16 @@ typename MpmBodies<dim>::Diagnostics MpmBodies<dim>::diagnostics(const std::arra
         q0 += m * p.v(q, 0);
         q1 += m * p.v(q, 1);
         if constexpr (dim == 3) q2 += m * p.v(q, 2);
+        mm += m;
+        x0 += m * p.x(q, 0);
+        x1 += m * p.x(q, 1);
+        if constexpr (dim == 3) x2 += m * p.x(q, 2);
         // z angular momentum: x v_y - y v_x, plus the APIC affine part
         // m (B^T)_{xy} - m (B^T)_{yx} with B = C D.
         l += m * (p.x(q, 0) * p.v(q, 1) - p.x(q, 1) * p.v(q, 0));
         if (apic) l += m * D * (p.C(q, 1, 0) - p.C(q, 0, 1));
       },
-      ke, el, pe, p0, p1, p2, L);
+      ke, el, pe, p0, p1, p2, L, M, X0, X1, X2);
   Diagnostics d;
   d.kinetic = ke;
   d.elastic = el;
@@ -198,6 +204,10 @@ typename MpmBodies<dim>::Diagnostics MpmBodies<dim>::diagnostics(const std::arra
   d.momentum[1] = p1;
   d.momentum[2] = p2;
   d.angular = L;
+  d.mass = M;
+  d.first_moment[0] = X0;
+  d.first_moment[1] = X1;
+  d.first_moment[2] = X2;
   return d;
 }
 

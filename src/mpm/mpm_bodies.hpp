@@ -86,8 +86,16 @@ class MpmBodies {
   // Particle diagnostics: kinetic, elastic (sum V0 psi(F_p)), gravity potential,
   // linear momentum, angular momentum about the origin (z; APIC adds the
   // affine part m_p (B_p)^T term).
-  struct Diagnostics { double kinetic = 0, elastic = 0, potential = 0; double momentum[3] = {0, 0, 0}; double angular = 0; };
-  Diagnostics diagnostics(const std::array<double, 3>& gravity) const;
+  // With body >= 0 only that body's particles count. mass and first_moment
+  // (sum m x) give the centre of mass.
+  struct Diagnostics {
+    double kinetic = 0, elastic = 0, potential = 0;
+    double momentum[3] = {0, 0, 0};
+    double angular = 0;
+    double mass = 0, first_moment[3] = {0, 0, 0};
+  };
+  Diagnostics diagnostics(const std::array<double, 3>& gravity, int body = -1) const;
+  const std::vector<std::string>& body_names() const { return setup_.body_names; }
 
  private:
   MpmSetup<dim> setup_;

@@ -1,5 +1,7 @@
 #include "sim/simulation.hpp"
 
+#include <limits>
+
 #include <Kokkos_Timer.hpp>
 #include <iostream>
 #include <sstream>
@@ -304,6 +306,11 @@ StepReport Simulation<dim>::step() {
     r.barrier_energy = contact_report.barrier_energy;
     r.ccd_alpha_min = contact_report.ccd_alpha_min;
     r.contact_force = contact_report.force;
+    for (int c = 0; c < 3; ++c) {
+      const bool none = !(contact_report.extent_lo[c] <= contact_report.extent_hi[c]);
+      r.contact_lo[c] = none ? std::numeric_limits<double>::quiet_NaN() : contact_report.extent_lo[c];
+      r.contact_hi[c] = none ? std::numeric_limits<double>::quiet_NaN() : contact_report.extent_hi[c];
+    }
     r.friction_iters = friction_iters;
     r.contact_broad_phase_s = contact_report.timings.broad_phase_s;
     r.contact_eval_s = contact_report.timings.evaluation_s;
@@ -395,7 +402,56 @@ StepReport Simulation<dim>::diagnostics() const {
     r.min_J = std::min(r.min_J, mpm_particle_min_J(mpm_->particles()));
     r.active_grid_nodes = mpm_->active_nodes();
   }
+  for (const auto& b : mesh_.bodies) {
+    BodyReport br;
+    double M = 0, k = 0, X[3] = {0, 0, 0}, P[3] = {0, 0, 0};
+    const LO i0 = b.first_node * dim, i1 = (b.first_node + b.num_nodes) * dim;
+    Kokkos::parallel_reduce(
+        "fem_body_diagnostics", Kokkos::RangePolicy<ExecSpace>(i0, i1),
+        KOKKOS_LAMBDA(const LO i, double& mm, double& kk, double& x0, double& x1, double& x2, double& q0,
+                      double& q1, double& q2) {
+          const int c = i % dim;
+          if (c == 0) mm += m(i);
+          kk += 0.5 * m(i) * v(i) * v(i);
+          const double mx = m(i) * x(i), mv = m(i) * v(i);
+          if (c == 0) x0 += mx, q0 += mv;
+          if (c == 1) x1 += mx, q1 += mv;
+          if (c == 2) x2 += mx, q2 += mv;
+        },
+        M, k, X[0], X[1], X[2], P[0], P[1], P[2]);
+    br.mass = M;
+    br.kinetic = k;
+    br.elastic = deformation_energy(mesh_.elements, x_, b.first_cell, b.first_cell + b.num_cells);
+    for (int c = 0; c < dim; ++c) {
+      br.com[c] = M > 0 ? X[c] / M : 0.0;
+      br.velocity[c] = M > 0 ? P[c] / M : 0.0;
+    }
+    r.bodies.push_back(br);
+  }
+  if (mpm_) {
+    for (std::size_t b = 0; b < mpm_->body_names().size(); ++b) {
+      const auto d = mpm_->diagnostics(setup_.gravity, static_cast<int>(b));
+      BodyReport br;
+      br.mass = d.mass;
+      br.kinetic = d.kinetic;
+      br.elastic = d.elastic;
+      for (int c = 0; c < dim; ++c) {
+        br.com[c] = d.mass > 0 ? d.first_moment[c] / d.mass : 0.0;
+        br.velocity[c] = d.mass > 0 ? d.momentum[c] / d.mass : 0.0;
+      }
+      r.bodies.push_back(br);
+    }
+  }
   return r;
+}
+
+template <int dim>
+std::vector<std::string> Simulation<dim>::body_names() const {
+  std::vector<std::string> names;
+  for (const auto& b : mesh_.bodies) names.push_back(b.name);
+  if (mpm_)
+    for (const auto& n : mpm_->body_names()) names.push_back(n);
+  return names;
 }
 
 template <int dim>

@@ -36,6 +36,14 @@ struct SimulationSetup {
   Teuchos::ParameterList linear_solver;                 // resolved "Linear Solver" list
 };
 
+// One body's share of a StepReport: mass, centre of mass (mass-weighted mean
+// of node / particle positions, m), its velocity (m/s), kinetic and elastic
+// energy (J, per unit thickness in 2D).
+struct BodyReport {
+  double mass = 0, kinetic = 0, elastic = 0;
+  std::array<double, 3> com{0, 0, 0}, velocity{0, 0, 0};
+};
+
 struct StepReport {
   long step = 0;
   double time = 0, dt = 0;
@@ -52,8 +60,11 @@ struct StepReport {
   double min_distance = 0, barrier_energy = 0, ccd_alpha_min = 0;
   int friction_iters = 0;
   std::array<double, 3> contact_force{0, 0, 0};
+  // Box of the particles in contact with that body (NaN without pairs).
+  std::array<double, 3> contact_lo{0, 0, 0}, contact_hi{0, 0, 0};
   double contact_broad_phase_s = 0, contact_eval_s = 0, contact_ccd_s = 0;
   double step_s = 0;
+  std::vector<BodyReport> bodies;  // in the order of Simulation::body_names()
   double total_energy() const { return kinetic + elastic + potential; }
 };
 
@@ -101,6 +112,8 @@ class Simulation {
   // The energy terms this scene built (names, in assembly order): only what
   // it needs (no MPM, contact or friction term unless the scene has them).
   std::vector<std::string> term_names() const;
+  // FEM bodies in scene order, then MPM bodies: the order of StepReport::bodies.
+  std::vector<std::string> body_names() const;
   // FEM node-interleaved state; tests may set initial velocities before step().
   Kokkos::View<double*, MemSpace> positions() const { return x_; }
   Kokkos::View<double*, MemSpace> velocities() const { return v_; }

@@ -6,9 +6,10 @@
 // box slides along +x. Nothing holds the box: it starts at its resting
 // distance (0.99994 dhat, where the barrier carries the normal weight), what
 // normal transient is left dies out under backward Euler, and
-// the acceleration along the slope is measured from the particles the run
-// produces: a least-squares quadratic fit of the mass-weighted mean particle x
-// over a window after the transient. Compared to a = g (sin theta - mu cos
+// the acceleration along the slope is measured with the probe the validation
+// report uses: a least-squares quadratic fit of the box's centre of mass x (the
+// mass-weighted mean particle x, diagnostics column box.com_x) over a window
+// after the transient. Compared to a = g (sin theta - mu cos
 // theta) for mu = 0, 0.1, 0.1999; at the critical mu = 0.2 the box may only
 // creep at the static-friction speed eps_v. Every step: no particle at or
 // below the slope surface, every contact distance > 0, and with mu > 0 the
@@ -22,6 +23,7 @@
 
 #include "common/fem_fixtures.hpp"
 #include "io/scene.hpp"
+#include "probes/probes.hpp"
 
 using namespace bfemp;
 
@@ -34,7 +36,7 @@ constexpr double kEpsV = 1e-5;
 const double kSin = kTan / std::sqrt(1 + kTan * kTan), kCos = 1 / std::sqrt(1 + kTan * kTan);
 
 struct SlopeRun {
-  std::vector<double> t, xc, vc;  // time, mass-weighted mean particle x and x-velocity
+  RunTable table;  // diagnostics.csv's columns: box.com_x is the mass-weighted mean particle x
   double min_gap = std::numeric_limits<double>::infinity();  // min particle y - surface over all steps
   double gap0 = 0;                                            // at t = 0
   double min_distance = std::numeric_limits<double>::infinity();
@@ -51,29 +53,20 @@ SlopeRun run_slope(double mu, int steps) {
   const auto t0 = std::chrono::steady_clock::now();
   Simulation<2> sim(build_setup<2>(scene), fixtures::comm());
   SlopeRun run;
-  double M = 0;
-  auto sample = [&](double t) {
+  run.table = RunTable::for_bodies(sim.body_names());
+  auto sample = [&]() {
     const auto& p = sim.mpm()->particles();
     auto x = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), p.x);
-    auto v = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), p.v);
-    auto m = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), p.mass);
-    double mx = 0, mv = 0, ymin = std::numeric_limits<double>::infinity();
-    M = 0;
-    for (std::size_t q = 0; q < p.size(); ++q) {
-      M += m(q);
-      mx += m(q) * x(q, 0);
-      mv += m(q) * v(q, 0);
-      ymin = std::min(ymin, x(q, 1));
-    }
-    run.t.push_back(t);
-    run.xc.push_back(mx / M);
-    run.vc.push_back(mv / M);
+    double ymin = std::numeric_limits<double>::infinity();
+    for (std::size_t q = 0; q < p.size(); ++q) ymin = std::min(ymin, x(q, 1));
     run.min_gap = std::min(run.min_gap, ymin - kSurface);
     return ymin - kSurface;
   };
-  run.gap0 = sample(0.0);
+  run.gap0 = sample();
+  run.table.record(sim.diagnostics());
   for (int n = 0; n < steps; ++n) {
     const StepReport r = sim.step();
+    run.table.record(r);
     run.newton_iters += r.newton.iterations;
     if (r.contact_pairs > 0) {
       ++run.contact_steps;
@@ -81,41 +74,15 @@ SlopeRun run_slope(double mu, int steps) {
       if (mu > 0 && r.friction_iters < 2) ++run.single_friction_solve;
       run.max_friction_iters = std::max<long>(run.max_friction_iters, r.friction_iters);
     }
-    sample(r.time);
+    sample();
   }
   run.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   run.missing_block_rebuilds = sim.newton().dof_space().missing_block_rebuilds();
   return run;
 }
 
-// a from the least-squares fit x = c0 + c1 (t - tm) + c2 (t - tm)^2 over
-// samples [n0, n1]: a = 2 c2.
-double fitted_acceleration(const SlopeRun& r, std::size_t n0, std::size_t n1) {
-  double tm = 0;
-  for (std::size_t i = n0; i <= n1; ++i) tm += r.t[i];
-  tm /= double(n1 - n0 + 1);
-  double S[5] = {0, 0, 0, 0, 0}, B[3] = {0, 0, 0};
-  const double x0 = r.xc[n0];
-  for (std::size_t i = n0; i <= n1; ++i) {
-    const double s = r.t[i] - tm, y = r.xc[i] - x0;
-    double sk = 1;
-    for (int k = 0; k < 5; ++k) {
-      S[k] += sk;
-      if (k < 3) B[k] += sk * y;
-      sk *= s;
-    }
-  }
-  // Normal equations [[S0 S1 S2] [S1 S2 S3] [S2 S3 S4]] c = B by Cramer's rule.
-  auto det3 = [](double a, double b, double c, double d, double e, double f, double g, double h, double i) {
-    return a * (e * i - f * h) - b * (d * i - f * g) + c * (d * h - e * g);
-  };
-  const double D = det3(S[0], S[1], S[2], S[1], S[2], S[3], S[2], S[3], S[4]);
-  const double D2 = det3(S[0], S[1], B[0], S[1], S[2], B[1], S[2], S[3], B[2]);
-  return 2 * D2 / D;
-}
-
-constexpr int kSteps = 300;                  // 0.3 s at dt = 1e-3
-constexpr std::size_t kW0 = 100, kW1 = 300;  // fit window t in [0.1, 0.3] s
+constexpr int kSteps = 300;               // 0.3 s at dt = 1e-3
+constexpr double kT0 = 0.1, kT1 = 0.3;    // fit window (s)
 
 void expect_common(const SlopeRun& r, double mu) {
   EXPECT_GT(r.gap0, 0.0);
@@ -133,11 +100,12 @@ void check_sliding(double mu, double rel_band) {
   const SlopeRun r = run_slope(mu, kSteps);
   expect_common(r, mu);
   const double a_exact = kG * (kSin - mu * kCos);
-  const double a_fit = fitted_acceleration(r, kW0, kW1);
-  const double a_vel = (r.vc[kW1] - r.vc[kW0]) / (r.t[kW1] - r.t[kW0]);
+  // The validation report's probe (scripts/validate.py: acceleration:body=box,axis=x,from=0.1,to=0.3).
+  const double a_fit = probe::acceleration(r.table, "box", 0, kT0, kT1);
+  const double a_vel = (probe::velocity(r.table, "box", 0, kT1) - probe::velocity(r.table, "box", 0, kT0)) / (kT1 - kT0);
   const double err = std::abs(a_fit - a_exact) / a_exact;
   std::cout.precision(10);
-  std::cout << "slope mu = " << mu << ": a (fit of particle mean x, t in [" << r.t[kW0] << ", " << r.t[kW1]
+  std::cout << "slope mu = " << mu << ": a (fit of the box's centre of mass x, t in [" << kT0 << ", " << kT1
             << "] s) = " << a_fit << ", from mean particle velocity " << a_vel << ", exact " << a_exact
             << ", rel. error " << err << " (velocity: " << std::abs(a_vel - a_exact) / a_exact
             << "); min gap " << r.min_gap << " m, max friction iterations " << r.max_friction_iters
@@ -156,13 +124,13 @@ TEST(ContactSlope, SlideJustBelowCriticalFrictionMatchesCoulomb) { check_sliding
 TEST(ContactSlope, CriticalFrictionHoldsTheBoxAtTheStaticFrictionSpeed) {
   const SlopeRun r = run_slope(0.2, kSteps);
   expect_common(r, 0.2);
-  double vmax = 0;
-  for (double v : r.vc) vmax = std::max(vmax, std::abs(v));
-  const double a_fit = fitted_acceleration(r, kW0, kW1);
+  const double vmax = probe::max_speed(r.table, "box", 0, 0.0, kT1);
+  const double a_fit = probe::acceleration(r.table, "box", 0, kT0, kT1);
   std::cout.precision(10);
   std::cout << "slope mu = 0.2: max |mean particle velocity| " << vmax << " m/s (" << vmax / kEpsV
-            << " eps_v), final " << r.vc.back() << " m/s, a (fit, t in [" << r.t[kW0] << ", " << r.t[kW1]
-            << "] s) = " << a_fit << " (g sin theta = " << kG * kSin << "), slid " << r.xc.back() - r.xc.front()
+            << " eps_v), final " << probe::velocity(r.table, "box", 0, kT1) << " m/s, a (fit, t in [" << kT0
+            << ", " << kT1 << "] s) = " << a_fit << " (g sin theta = " << kG * kSin << "), slid "
+            << probe::com(r.table, "box", 0, kT1) - probe::com(r.table, "box", 0, 0.0)
             << " m, max friction iterations " << r.max_friction_iters << ", " << r.seconds << " s\n";
   EXPECT_LT(vmax, 10 * kEpsV) << "the box must not slide faster than of order eps_v";
   EXPECT_LT(std::abs(a_fit), 1e-4 * kG * kSin) << "the acceleration must vanish at the critical friction";

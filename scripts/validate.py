@@ -1,0 +1,261 @@
+#!/usr/bin/env python3
+"""The BFEMP validation report (VALIDATION.md section A): runs the paper's
+scenes with `bfemp run`, measures each band with `bfemp probe` (the probes the
+tests use), and writes OUT/report.md (one row per band) with a PNG per scene
+drawn from the runs' own diagnostics.csv.
+
+    validate.py [--size ci|paper] [--scenes A1,A3,A4] [--out DIR] [--bfemp PATH]
+
+Scenes: A1 rings (APIC, FLIP), A3 Brazilian disk (linear, neo-Hookean), A4
+box on a slope (mu = 0, 0.1, 0.1999, 0.2). Each run goes into OUT/<run>/
+(bfemp.xdmf for ParaView, diagnostics.csv, log.txt). Threads: OMP_NUM_THREADS
+(default 2). Exit status 0 when every band that applies passes, 1 otherwise.
+Plots need matplotlib (Debian's python3-matplotlib); without it the report
+says so and the rows are still written."""
+import argparse
+import csv
+import math
+import os
+import subprocess
+import sys
+import time
+
+REPO = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+
+
+def scene_path(size, name):
+    if size == "paper":
+        return os.path.join(REPO, "inputs", "paper", name)
+    return os.path.join(REPO, "inputs", name)
+
+
+# Each scene: its runs (name, scene file, --set overrides) and its bands:
+# (run, measure, probe spec, paper figure, check(value) -> bool, or None for
+# "reported only", band text[, scale: the value shown and checked is the
+# probe's divided by it]).
+def scenes(size):
+    E3, nu3, R3 = 1e10, 0.3, 1.0
+    hertz = math.pi / 4 * E3 / (1 - nu3 ** 2) / R3
+    g, tan = 5.10, 0.2
+    sin, cos = tan / math.sqrt(1 + tan * tan), 1 / math.sqrt(1 + tan * tan)
+    a4_window = "from=0.1,to=0.3" if size == "ci" else "from=0.1,to=1.0"
+    s = {}
+    s["A1"] = {
+        "title": "A1 colliding rings (section 6.1, Figs. 6-7)",
+        "runs": [("A1_apic", scene_path(size, "contact_rings.yaml" if size == "ci" else "a1_rings.yaml"),
+                  ["MPM/transfer=APIC"]),
+                 ("A1_flip", scene_path(size, "contact_rings.yaml" if size == "ci" else "a1_rings.yaml"),
+                  ["MPM/transfer=FLIP"])],
+        "bands": [],
+        "plot": plot_a1,
+    }
+    for run, lost in (("A1_apic", 8.57), ("A1_flip", 9.67)):
+        s["A1"]["bands"] += [
+            (run, "momentum drift / |p| of one ring", "momentum_drift:axis=x,relative_to=left", "< 1e-6",
+             lambda v: v < 1e-6, "< 1e-6"),
+            (run, "contact start (s)", "contact_start", "0.025", lambda v: abs(v - 0.025) <= 2.5e-3, "0.025 +- 10 %"),
+            (run, "contact end (s)", "contact_end", "0.293",
+             (lambda v: abs(v - 0.293) <= 0.015) if size == "paper" else None, "0.293 +- 5 % (paper size)"),
+            (run, "energy lost during contact (%)", "energy_lost_pct", "%.2f" % lost,
+             (lambda v, lost=lost: abs(v - lost) <= 3.0), "+- 3 points"),
+        ]
+    s["A3"] = {
+        "title": "A3 Brazilian disk, Hertz contact (section 6.3, Figs. 9-10)",
+        "runs": [("A3_linear", scene_path(size, "a3_brazilian_disk.yaml"), ["Materials/disk/model=linear"]),
+                 ("A3_neohookean", scene_path(size, "a3_brazilian_disk.yaml"),
+                  ["Materials/disk/model=neo-hookean"])],
+        "bands": [],
+        "plot": plot_a3,
+    }
+    for run in ("A3_linear", "A3_neohookean"):
+        s["A3"]["bands"].append(
+            (run, "slope of F against a^2 / Hertz (pi/4) E/(1-nu^2)/R", "hertz_slope:a_max=0.25", "1",
+             lambda v: abs(v - 1) <= 0.2, "+- 20 %", hertz))
+    s["A4"] = {
+        "title": "A4 box on a slope, critical friction (section 6.4, Figs. 11-12)",
+        "runs": [("A4_mu%s" % mu, scene_path(size, "contact_slope.yaml"), ["Contact/friction=%s" % mu])
+                 for mu in ("0", "0.1", "0.1999", "0.2")],
+        "bands": [],
+        "plot": plot_a4,
+    }
+    for mu in ("0", "0.1", "0.1999"):
+        a = g * (sin - float(mu) * cos)
+        s["A4"]["bands"].append(
+            ("A4_mu%s" % mu, "acceleration / g (sin - mu cos)", "acceleration:body=box,axis=x," + a4_window,
+             "1", (lambda v: abs(v - 1) <= 1e-4), "+- 0.01 %", a))
+    s["A4"]["bands"].append(
+        ("A4_mu0.2", "max sliding speed / eps_v", "max_speed:body=box,axis=x," + a4_window, "O(1)",
+         lambda v: v < 10, "< 10", 1e-5))
+    return s
+
+
+def read_csv(path):
+    with open(path) as f:
+        rows = list(csv.DictReader(f))
+    cols = {k: [float(r[k]) for r in rows] for k in rows[0]} if rows else {}
+    return cols
+
+
+def probe(bfemp, run_dir, spec):
+    out = subprocess.run([bfemp, "probe", run_dir, spec], capture_output=True, text=True)
+    if out.returncode != 0:
+        raise RuntimeError(out.stderr.strip() or out.stdout.strip())
+    return float(out.stdout.strip().rsplit("=", 1)[1])
+
+
+def plt_or_none():
+    try:
+        import matplotlib
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+        return plt
+    except ImportError:
+        return None
+
+
+def plot_a1(plt, out, runs):
+    fig, axes = plt.subplots(2, 1, figsize=(7, 6), sharex=True)
+    for name, d in runs.items():
+        e0 = d["total_energy"][0]
+        axes[0].plot(d["time"], [e / e0 for e in d["total_energy"]], label=name + " total")
+        axes[0].plot(d["time"], [(k + e) / e0 for k, e in zip(d["left.kinetic"], d["left.elastic"])], "--",
+                     label=name + " MPM ring")
+        axes[0].plot(d["time"], [(k + e) / e0 for k, e in zip(d["right.kinetic"], d["right.elastic"])], ":",
+                     label=name + " FEM ring")
+        p0 = d["momentum_x"][0]
+        pr = d["left.mass"][0] * abs(d["left.vel_x"][0])
+        axes[1].plot(d["time"], [(p - p0) / pr for p in d["momentum_x"]], label=name)
+    axes[0].set_ylabel("energy / E(0)")
+    axes[0].legend(fontsize=7)
+    axes[1].set_ylabel("(p_x - p_x(0)) / |p| of one ring")
+    axes[1].set_xlabel("t (s)")
+    axes[1].legend(fontsize=7)
+    fig.suptitle("A1 colliding rings: energy and momentum (paper Fig. 7)")
+    fig.tight_layout()
+    fig.savefig(out, dpi=110)
+
+
+def plot_a3(plt, out, runs):
+    fig, ax = plt.subplots(figsize=(6, 5))
+    hertz = math.pi / 4 * 1e10 / (1 - 0.09)
+    amax = 0
+    for name, d in runs.items():
+        a = [0.5 * (h - l) for l, h in zip(d["contact_lo_x"], d["contact_hi_x"])]
+        F = [abs(f) for f in d["contact_force_y"]]
+        pts = [(x, f) for x, f in zip(a, F) if x == x and x > 0]
+        if pts:
+            amax = max(amax, max(p[0] for p in pts))
+            ax.plot([p[0] ** 2 for p in pts], [p[1] for p in pts], "o", ms=3, label=name)
+    xs = [0, amax ** 2]
+    ax.plot(xs, [hertz * x for x in xs], "k-", label="Hertz (Eq. 39)")
+    ax.set_xlabel("a^2 (m^2)")
+    ax.set_ylabel("F on the bottom plate (N/m)")
+    ax.legend()
+    ax.set_title("A3 Brazilian disk: F against a^2 (paper Fig. 10)")
+    fig.tight_layout()
+    fig.savefig(out, dpi=110)
+
+
+def plot_a4(plt, out, runs):
+    fig, axes = plt.subplots(2, 1, figsize=(7, 6), sharex=True)
+    for name, d in runs.items():
+        t, v = d["time"], d["box.vel_x"]
+        axes[0].plot(t, v, label=name)
+        acc = [(v[i + 1] - v[i - 1]) / (t[i + 1] - t[i - 1]) for i in range(1, len(t) - 1)]
+        axes[1].plot(t[1:-1], acc, label=name)
+    axes[0].set_ylabel("box velocity along the slope (m/s)")
+    axes[1].set_ylabel("acceleration (m/s^2)")
+    axes[1].set_xlabel("t (s)")
+    axes[0].legend(fontsize=7)
+    fig.suptitle("A4 box on a slope (paper Fig. 12)")
+    fig.tight_layout()
+    fig.savefig(out, dpi=110)
+
+
+def git_rev():
+    try:
+        return subprocess.run(["git", "-C", REPO, "describe", "--always", "--dirty"], capture_output=True,
+                              text=True).stdout.strip()
+    except OSError:
+        return "?"
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--size", choices=["ci", "paper"], default="ci")
+    ap.add_argument("--scenes", default="A1,A3,A4")
+    ap.add_argument("--out", default="validation-out")
+    ap.add_argument("--bfemp", default=os.path.join(REPO, "build", "drivers", "bfemp"))
+    args = ap.parse_args()
+    all_scenes = scenes(args.size)
+    wanted = [s.strip() for s in args.scenes.split(",") if s.strip()]
+    for w in wanted:
+        if w not in all_scenes:
+            sys.exit("validate: --scenes: '%s' is not one of %s" % (w, ", ".join(all_scenes)))
+    if not os.access(args.bfemp, os.X_OK):
+        sys.exit("validate: %s not found; build it first (ninja -C build bfemp)" % args.bfemp)
+    os.makedirs(args.out, exist_ok=True)
+    threads = os.environ.setdefault("OMP_NUM_THREADS", "2")
+    plt = plt_or_none()
+    report = ["# bfemp validation report (%s size)" % args.size, "",
+              "Commit `%s`, OMP_NUM_THREADS=%s, %s. Made by `scripts/validate.sh --size %s --scenes %s`." %
+              (git_rev(), threads, time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime()), args.size, args.scenes),
+              "", "| scene | run | measure | paper | bfemp | band | pass | wall (s) | Newton its |",
+              "|---|---|---|---|---|---|---|---|---|"]
+    all_pass = True
+    notes = []
+    for name in wanted:
+        sc = all_scenes[name]
+        results = {}
+        for run, path, sets in sc["runs"]:
+            d = os.path.join(args.out, run)
+            cmd = [args.bfemp, "run", path, "--output", d] + sum([["--set", s] for s in sets], [])
+            print("validate: %s ..." % run, end="", flush=True)
+            t0 = time.time()
+            os.makedirs(d, exist_ok=True)
+            with open(os.path.join(d, "log.txt"), "w") as log:
+                rc = subprocess.run(cmd, stdout=log, stderr=subprocess.STDOUT).returncode
+            wall = time.time() - t0
+            print(" %.1f s%s" % (wall, "" if rc == 0 else " (exit %d, see %s/log.txt)" % (rc, d)))
+            results[run] = {"rc": rc, "wall": wall, "dir": d}
+            csvp = os.path.join(d, "diagnostics.csv")
+            results[run]["data"] = read_csv(csvp) if os.path.exists(csvp) else {}
+        for band in sc["bands"]:
+            run, measure, spec, paper, check, band_text = band[:6]
+            scale = band[6] if len(band) > 6 else 1.0
+            r = results[run]
+            data = r["data"]
+            newton = int(sum(data.get("newton_iters", [])))
+            if r["rc"] != 0:
+                value, ok, shown = float("nan"), False, "run failed (exit %d)" % r["rc"]
+            else:
+                try:
+                    value = probe(args.bfemp, r["dir"], spec) / scale
+                    shown = "%.6g" % value
+                    ok = None if check is None else (value == value and bool(check(value)))
+                except RuntimeError as e:
+                    value, ok, shown = float("nan"), False, "probe failed: %s" % e
+            if ok is False:
+                all_pass = False
+            mark = "n/a" if ok is None else ("pass" if ok else "**FAIL**")
+            report.append("| %s | %s | %s | %s | %s | %s | %s | %.1f | %d |" %
+                          (name, run, measure, paper, shown, band_text, mark, r["wall"], newton))
+        if plt is not None:
+            png = os.path.join(args.out, name + ".png")
+            try:
+                sc["plot"](plt, png, {k: v["data"] for k, v in results.items() if v["data"]})
+                notes.append("![%s](%s.png)" % (sc["title"], name))
+            except (KeyError, ValueError, IndexError) as e:
+                notes.append("%s: no plot (%s)" % (name, e))
+        else:
+            notes.append("%s: no plot (matplotlib missing: install python3-matplotlib)" % name)
+    report += ["", "Each run's output: `<out>/<run>/` (bfemp.xdmf for ParaView, diagnostics.csv, log.txt).", ""]
+    report += notes
+    with open(os.path.join(args.out, "report.md"), "w") as f:
+        f.write("\n".join(report) + "\n")
+    print("validate: wrote %s" % os.path.join(args.out, "report.md"))
+    return 0 if all_pass else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,215 @@
+// Probes (src/probes) on run tables with known answers:
+//  - the centre-of-mass acceleration fit recovers a of x = x0 + v0 t + a t^2/2
+//    exactly (to round-off) at any time offset, and ignores rows outside the
+//    window;
+//  - contact start / end, the energy lost during contact, the momentum drift
+//    relative to a body, the Hertz slope of F = k a^2 + c and the combined
+//    centre of mass of two bodies equal their hand-computed values;
+//  - diagnostics.csv of a real run read back equals the table recorded in
+//    memory from the same StepReports (every column, every row), and its body
+//    columns hold the body's mass and centre of mass;
+//  - bad specs (unknown probe, misspelled key, bad axis, unknown body or
+//    column) are refused naming what was wrong; a torn last CSV row is
+//    dropped, a torn middle row refused.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <iterator>
+
+#include "common/fem_fixtures.hpp"
+#include "io/run_output.hpp"
+#include "io/scene.hpp"
+#include "probes/probes.hpp"
+
+using namespace bfemp;
+
+namespace {
+
+// A table for one body "b" with rows at t = t0 + k dt.
+RunTable table_of(int n, double t0, double dt, const std::function<void(double, StepReport&)>& fill) {
+  RunTable t = RunTable::for_bodies({"b"});
+  for (int k = 0; k < n; ++k) {
+    StepReport r;
+    r.step = k;
+    r.time = t0 + k * dt;
+    r.bodies.resize(1);
+    r.bodies[0].mass = 2.0;
+    fill(r.time, r);
+    t.record(r);
+  }
+  return t;
+}
+
+std::string error_of(const std::string& spec, const RunTable& t) {
+  try {
+    evaluate_probe(spec, t);
+  } catch (const std::invalid_argument& e) {
+    return e.what();
+  }
+  return "";
+}
+
+}  // namespace
+
+TEST(Probes, AccelerationFitIsExactForAQuadraticAndHonoursTheWindow) {
+  const double a = -3.7, v0 = 1.25, x0 = 10.0;
+  const RunTable t = table_of(401, 2.0, 1e-3, [&](double time, StepReport& r) {
+    const double s = time - 2.0;
+    // A different motion before t = 2.1 s: the window must exclude it.
+    r.bodies[0].com[1] = time < 2.1 ? 0.0 : x0 + v0 * s + 0.5 * a * s * s;
+  });
+  EXPECT_NEAR(probe::acceleration(t, "b", 1, 2.1, 2.4), a, 1e-9 * std::abs(a));
+  EXPECT_NEAR(evaluate_probe("acceleration:body=b,axis=y,from=2.1,to=2.4", t), a, 1e-9 * std::abs(a));
+  // Including the jump changes it: the window matters.
+  EXPECT_GT(std::abs(probe::acceleration(t, "b", 1, 2.0, 2.4) - a), 1.0);
+  EXPECT_DOUBLE_EQ(evaluate_probe("com:body=b,axis=y,t=2.2", t), x0 + v0 * 0.2 + 0.5 * a * 0.04);
+}
+
+TEST(Probes, ContactWindowEnergyLossMomentumDriftAndMaxima) {
+  // Contact from t = 0.3 to 0.5; energy 100 before, 91.43 after (8.57 % lost).
+  const RunTable t = table_of(11, 0.0, 0.1, [](double time, StepReport& r) {
+    const bool in = time > 0.25 && time < 0.55;
+    r.contact_pairs = in ? 7 : 0;
+    r.kinetic = time < 0.25 ? 100.0 : (in ? 50.0 : 91.43);
+    r.elastic = in ? 45.0 : 0.0;
+    r.momentum[0] = 80.0 + (time > 0.65 ? 4e-6 : 0.0);
+    r.bodies[0].velocity = {40.0, 0.0, 0.0};
+    r.newton.iterations = 3;
+  });
+  EXPECT_DOUBLE_EQ(probe::contact_start(t), 0.3);
+  EXPECT_DOUBLE_EQ(probe::contact_end(t), 0.5);
+  EXPECT_NEAR(evaluate_probe("energy_lost_pct", t), 8.57, 1e-12);
+  EXPECT_NEAR(evaluate_probe("energy_lost_pct:from=0,to=0.4", t), 5.0, 1e-12);
+  // |p| of body b at t = 0: 2 kg x 40 m/s.
+  // (80 + 4e-6) - 80 carries the round-off of 80: 80 eps / 80 relative.
+  EXPECT_NEAR(evaluate_probe("momentum_drift:axis=x,relative_to=b", t), 4e-6 / 80.0, 4e-15 / 80.0);
+  EXPECT_DOUBLE_EQ(evaluate_probe("sum:column=newton_iters", t), 33.0);
+  EXPECT_DOUBLE_EQ(evaluate_probe("max:column=contact_pairs,from=0.6", t), 0.0);
+  EXPECT_DOUBLE_EQ(evaluate_probe("min:column=kinetic", t), 50.0);
+  // No separation yet: the loss during contact is undefined.
+  const RunTable open = table_of(4, 0.0, 0.1, [](double time, StepReport& r) { r.contact_pairs = time > 0.15; });
+  EXPECT_TRUE(std::isnan(evaluate_probe("energy_lost_pct", open)));
+  EXPECT_TRUE(std::isnan(probe::contact_start(table_of(3, 0, 1, [](double, StepReport&) {}))));
+}
+
+TEST(Probes, HertzSlopeAndHalfWidth) {
+  // a grows linearly; F = k a^2 + c on the bottom plate, pushing down (F_y < 0).
+  const double k = 8.6e9, c = 1.5e3;
+  const RunTable t = table_of(20, 0.0, 0.01, [&](double time, StepReport& r) {
+    const double a = 0.01 * std::round(time / 0.01);
+    r.contact_lo = {0.3 - a, 0.0, 0.0};
+    r.contact_hi = {0.3 + a, 0.0, 0.0};
+    r.contact_force = {0.0, -(k * a * a + c), 0.0};
+    if (a == 0) {
+      r.contact_lo[0] = r.contact_hi[0] = std::nan("");
+      r.contact_force[1] = 0;
+    }
+  });
+  EXPECT_NEAR(evaluate_probe("half_width:t=0.05", t), 0.05, 1e-15);
+  EXPECT_TRUE(std::isnan(evaluate_probe("half_width:t=0", t)));
+  EXPECT_NEAR(evaluate_probe("hertz_slope", t), k, 1e-9 * k);
+  EXPECT_NEAR(evaluate_probe("hertz_slope:a_max=0.1", t), k, 1e-9 * k);
+  // Only the first two contact rows (a = 0.01, 0.02) below a_max = 0.025.
+  EXPECT_NEAR(probe::fit_slope({1e-4, 4e-4}, {k * 1e-4 + c, k * 4e-4 + c}), k, 1e-9 * k);
+}
+
+TEST(Probes, EquilibriumHeightWeighsBodiesByMass) {
+  RunTable t = RunTable::for_bodies({"top", "base"});
+  StepReport r;
+  r.bodies.resize(2);
+  r.bodies[0].mass = 2000.0;
+  r.bodies[0].com = {0.0, 1.5, 0.0};
+  r.bodies[1].mass = 400.0;
+  r.bodies[1].com = {0.0, 0.5, 0.0};
+  t.record(r);
+  EXPECT_NEAR(evaluate_probe("equilibrium_height:bodies=top+base", t), (2000 * 1.5 + 400 * 0.5) / 2400.0, 1e-15);
+  EXPECT_DOUBLE_EQ(evaluate_probe("equilibrium_height:bodies=base", t), 0.5);
+}
+
+TEST(Probes, BadSpecsAreRefusedNamingTheProblem) {
+  const RunTable t = table_of(5, 0.0, 0.1, [](double, StepReport&) {});
+  EXPECT_NE(error_of("accel:body=b", t).find("probe 'accel' unknown"), std::string::npos) << error_of("accel", t);
+  EXPECT_NE(error_of("acceleration:bdy=b", t).find("bdy"), std::string::npos);
+  EXPECT_NE(error_of("acceleration:body=b,axis=w", t).find("x, y or z"), std::string::npos);
+  EXPECT_NE(error_of("acceleration:body=nobody", t).find("no body 'nobody'"), std::string::npos);
+  EXPECT_NE(error_of("max:column=speed", t).find("no column 'speed'"), std::string::npos);
+  EXPECT_NE(error_of("acceleration", t).find("body"), std::string::npos) << "a required key";
+  EXPECT_NE(error_of("value:column=time,t=soon", t).find("a number"), std::string::npos);
+  // "max" is not a key of hertz_slope even though "a_max" is.
+  EXPECT_NE(error_of("hertz_slope:max=1", t).find("max"), std::string::npos);
+}
+
+TEST(Probes, CsvOfARealRunEqualsTheRecordedTableAndTornRowsAreHandled) {
+  const std::string dir = (std::filesystem::temp_directory_path() / "bfemp_test_probes").string();
+  std::filesystem::remove_all(dir);
+  const Scene scene = load_scene(std::string(BFEMP_SOURCE_DIR) + "/inputs/contact_slope.yaml",
+                                 {"Time/end time=0.005", "Output/frame every=100"});
+  Simulation<2> sim(build_setup<2>(scene), fixtures::comm());
+  ASSERT_EQ(sim.body_names(), (std::vector<std::string>{"slope", "box"}));
+  RunTable mem = RunTable::for_bodies(sim.body_names());
+  double M = 0, mx = 0, my = 0;  // the box's particles at t = 0
+  {
+    const auto& p = sim.mpm()->particles();
+    auto x = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), p.x);
+    auto m = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), p.mass);
+    for (std::size_t q = 0; q < p.size(); ++q) M += m(q), mx += m(q) * x(q, 0), my += m(q) * x(q, 1);
+  }
+  mem.record(sim.diagnostics());
+  {
+    RunOutput<2> out(dir, scene, sim);
+    for (int n = 0; n < 5; ++n) {
+      const StepReport r = sim.step();
+      out.write_diagnostics(r);
+      mem.record(r);
+    }
+    out.close();
+  }
+  const RunTable csv = RunTable::read_csv(dir);
+  ASSERT_EQ(csv.columns(), mem.columns());
+  ASSERT_EQ(csv.rows(), 5u);
+  ASSERT_EQ(mem.rows(), 6u);  // row 0: the initial state
+  for (const auto& c : csv.columns())
+    for (std::size_t i = 0; i < 5; ++i) {
+      const double a = csv.column(c)[i], b = mem.column(c)[i + 1];
+      if (std::isnan(b)) {
+        EXPECT_TRUE(std::isnan(a)) << c;
+      } else {
+        EXPECT_EQ(a, b) << c << " row " << i;  // %.17g round-trips doubles
+      }
+    }
+  EXPECT_EQ(csv.bodies(), (std::vector<std::string>{"slope", "box"}));
+  // The box: 0.1025 x 0.0225 m at density 100 kg/m^2; its centre of mass.
+  EXPECT_NEAR(mem.column("box.mass")[0], 100.0 * 0.1025 * 0.0225, 1e-3 * M);
+  EXPECT_NEAR(mem.column("box.mass")[0], M, 1e-12 * M);
+  EXPECT_NEAR(probe::com(mem, "box", 0, 0.0), mx / M, 1e-12);
+  EXPECT_NEAR(probe::com(mem, "box", 1, 0.0), my / M, 1e-12);
+  EXPECT_GT(csv.column("slope.mass")[0], 0.0);
+  EXPECT_EQ(csv.column("slope.kinetic")[4], 0.0) << "the slope is fixed";
+
+  // A torn last row (a run still writing) is dropped; a torn middle row is an error.
+  std::string text;
+  {
+    std::ifstream in(dir + "/diagnostics.csv");
+    text.assign(std::istreambuf_iterator<char>(in), {});
+  }
+  {
+    std::ofstream o(dir + "/torn.csv");
+    o << text << "6,0.006,0.001,1.5";
+  }
+  EXPECT_EQ(RunTable::read_csv(dir + "/torn.csv").rows(), 5u);
+  {
+    std::ofstream o(dir + "/torn2.csv");
+    const auto second = text.find('\n', text.find('\n') + 1);
+    o << text.substr(0, second + 1) << "2,0.002\n" << text.substr(second + 1);
+  }
+  try {
+    RunTable::read_csv(dir + "/torn2.csv");
+    ADD_FAILURE() << "a torn middle row was accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("line 3"), std::string::npos) << e.what();
+  }
+  std::filesystem::remove_all(dir);
+}
