@@ -16,6 +16,8 @@
 #include <limits>
 
 #include "common/fem_fixtures.hpp"
+#include <Teuchos_Array.hpp>
+
 #include "io/scene.hpp"
 #include "solver/solver_error.hpp"
 
@@ -153,16 +155,41 @@ TEST(Extreme, FrictionCoefficientTen) {
   expect_completed("mu=10", run_case(kRolling, {"Contact/friction=10.0", "Time/end time=4.0e-2"}), 20);
 }
 
+// Largest distance of a particle coordinate (axis c) from the nearest grid line.
+double off_line(const std::vector<std::string>& sets, int c) {
+  const Scene scene = load_scene(kDiskWall, sets);
+  const auto& mpm = scene.params.sublist("MPM");
+  const double dx = mpm.get<double>("grid spacing");
+  const double lo = mpm.get<Teuchos::Array<double>>("domain min")[c];
+  Simulation<2> sim(build_setup<2>(scene), fixtures::comm());
+  auto x = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), sim.mpm()->particles().x);
+  double worst = 0;
+  for (std::size_t q = 0; q < x.extent(0); ++q) {
+    const double s = (x(q, c) - lo) / dx;
+    worst = std::max(worst, std::abs(s - std::round(s)) * dx);
+  }
+  return worst;
+}
+
+// One particle per cell sits on the lattice (m + 1/2) dx = 0.025 + 0.05 m;
+// grids shifted to start at -0.625 have nodes (or lines) exactly there.
 TEST(Extreme, ParticlesOnGridNodes) {
-  // Shifting the grid by dx/4 puts every particle of the disk on a grid node.
+  const std::vector<std::string> sets = {"MPM/particles per cell=1", "MPM/domain min=[-0.625, -0.625]",
+                                         "MPM/domain max=[0.625, 0.625]"};
+  EXPECT_LT(off_line(sets, 0), 1e-12);
+  EXPECT_LT(off_line(sets, 1), 1e-12);
   expect_completed("particles on nodes",
-                   run_case(kDiskWall, {"MPM/domain min=[-0.6125, -0.6125]", "MPM/domain max=[0.5875, 0.5875]"}), 20);
+                   run_case(kDiskWall, {"MPM/particles per cell=1", "MPM/domain min=[-0.625, -0.625]",
+                                        "MPM/domain max=[0.625, 0.625]"}), 20);
 }
 
 TEST(Extreme, ParticlesOnGridLines) {
-  // Shifted along x only: particles on vertical grid lines, between nodes in y.
+  // On vertical grid lines, at mid-cell in y.
+  EXPECT_LT(off_line({"MPM/particles per cell=1", "MPM/domain min=[-0.625, -0.6]"}, 0), 1e-12);
+  EXPECT_NEAR(off_line({"MPM/particles per cell=1", "MPM/domain min=[-0.625, -0.6]"}, 1), 0.025, 1e-12);
   expect_completed("particles on lines",
-                   run_case(kDiskWall, {"MPM/domain min=[-0.6125, -0.6]", "MPM/domain max=[0.5875, 0.6]"}), 20);
+                   run_case(kDiskWall, {"MPM/particles per cell=1", "MPM/domain min=[-0.625, -0.6]",
+                                        "MPM/domain max=[0.625, 0.6]"}), 20);
 }
 
 TEST(Extreme, NineParticlesPerCellInContact) {
