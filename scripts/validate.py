@@ -42,10 +42,10 @@ def scenes(size):
     s = {}
     s["A1"] = {
         "title": "A1 colliding rings (section 6.1, Figs. 6-7)",
-        "runs": [("A1_apic", scene_path(size, "contact_rings.yaml" if size == "ci" else "a1_rings.yaml"),
-                  ["MPM/transfer=APIC"]),
-                 ("A1_flip", scene_path(size, "contact_rings.yaml" if size == "ci" else "a1_rings.yaml"),
-                  ["MPM/transfer=FLIP"])],
+        # The ci scene ends in contact (its test); the report runs it past separation.
+        "runs": [(run, scene_path(size, "contact_rings.yaml" if size == "ci" else "a1_rings.yaml"),
+                  ["MPM/transfer=" + scheme] + (["Time/end time=0.4"] if size == "ci" else []))
+                 for run, scheme in (("A1_apic", "APIC"), ("A1_flip", "FLIP"))],
         "bands": [],
         "plot": plot_a1,
     }

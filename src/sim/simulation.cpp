@@ -168,7 +168,13 @@ void Simulation<dim>::prescribed_velocities(double t1) {
 // its gradient vanish: 9 particles per cell in 2D, 27 in 3D) carry no mass
 // and no stiffness, so the Newton matrix would be singular there. They take
 // no part in any transfer; hold them in place (prescribed, v = 0, mass 0).
-// "No mass": below 1e-12 of the heaviest node (round-off of a zero weight).
+// "No mass": below 1e-8 of the heaviest node. Not just exact zeros: once such
+// a particle moves by delta dx its weight there is delta^2 / 2 (1e-8 for a
+// displacement of 1.4e-4 dx), and a node of relative mass 1e-12..1e-8 has a
+// stiffness so small that the Newton direction there is round-off: Newton
+// stalled at |p|/dt ~ 5e-7 m/s (Brazilian disk, 9 per cell, eps_d = 1e-8,
+// step 2). Holding a node of relative mass w moves its particles by O(w) of
+// their velocity (1e-7 relative at most), far inside the Newton tolerance.
 namespace {
 void hold_massless_grid_nodes(std::size_t first, std::size_t n, View1 x, View1 v, View1 mass, View1 target,
                               Kokkos::View<int*, MemSpace> pres) {
@@ -176,7 +182,7 @@ void hold_massless_grid_nodes(std::size_t first, std::size_t n, View1 x, View1 v
   Kokkos::parallel_reduce(
       "grid_mass_max", Kokkos::RangePolicy<ExecSpace>(first, n),
       KOKKOS_LAMBDA(const std::size_t i, double& m) { m = mass(i) > m ? mass(i) : m; }, Kokkos::Max<double>(mmax));
-  const double floor = 1e-12 * mmax;
+  const double floor = 1e-8 * mmax;
   Kokkos::parallel_for(
       "grid_hold_massless", Kokkos::RangePolicy<ExecSpace>(first, n), KOKKOS_LAMBDA(const std::size_t i) {
         if (mass(i) > floor) return;

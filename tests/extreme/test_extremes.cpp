@@ -197,6 +197,19 @@ TEST(Extreme, NineParticlesPerCellInContact) {
   expect_completed("ppc=9", run_case(kDiskWall, {"MPM/particles per cell=9"}), 20);
 }
 
+TEST(Extreme, NineParticlesPerCellTightToleranceConverges) {
+  // The Brazilian disk (A3) at 9 per cell with eps_d = 1e-8: after step 1 the
+  // cell-centre particles have moved by ~1e-6 dx and reach the far nodes with
+  // weights 1e-12..1e-8; Newton stalled at |p|/dt ~ 5e-7 m/s in step 2 (300
+  // iterations) until such nodes were held like massless ones.
+  const std::string disk = std::string(BFEMP_SOURCE_DIR) + "/inputs/a3_brazilian_disk.yaml";
+  const Outcome o = run_case(disk, {"MPM/particles per cell=9", "Time/end time=0.04",
+                                    "FEM Bodies/bottom/Mesh/center=[0.0, -1.0417167]",
+                                    "FEM Bodies/top/Mesh/center=[0.0, 1.0417167]"});
+  expect_completed("ppc=9, eps_d=1e-8", o, 4);
+  EXPECT_LT(o.iterates, 4 * 30) << "Newton must converge in a few iterations per step, not stall";
+}
+
 TEST(Extreme, BodiesThatStartIntersectingAreRefused) {
   // The disk (radius 0.2) centred 0.1 m left of the wall's face overlaps it.
   expect_refused("intersecting", run_case(kDiskWall, {"MPM Bodies/disk/center=[0.05, 0.0]"}), "MPM particle");
