@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Sets everything up on a fresh machine (packages, Trilinos), builds bfemp and
-# runs the whole test suite (labels unit, scene, mpi).   Usage: scripts/test.sh
+# runs the whole test suite (labels unit, scene, extreme, mpi, paraview).   Usage: scripts/test.sh
 set -euo pipefail
 cd "$(dirname "$0")/.."
 if [ "$(id -u)" = 0 ]; then scripts/setup.sh; else sudo scripts/setup.sh; fi

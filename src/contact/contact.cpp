@@ -43,6 +43,33 @@ LO Contact<dim>::particle_inside(ConstDofView xp, ConstDofView x) const {
 }
 
 template <int dim>
+LO Contact<dim>::count_inside(ConstDofView xp, ConstDofView x) const {
+  const auto& el = mesh_.elements;
+  const LO np = static_cast<LO>(xp.extent(0) / dim);
+  if (el.size() == 0 || np == 0) return 0;
+  simplex_boxes<dim, dim + 1>(el.nodes, x, ConstDofView(), 0.0, element_boxes_);
+  point_boxes<dim>(xp, ConstDofView(), 0.0, point_boxes_);
+  element_hash_.build(element_boxes_);
+  const LO n = element_hash_.query(point_boxes_, inside_pairs_);
+  if (static_cast<LO>(inside_flag_.extent(0)) != np) inside_flag_ = Kokkos::View<int*, MemSpace>("contact_inside_flag", np);
+  Kokkos::deep_copy(inside_flag_, 0);
+  const auto pairs = inside_pairs_;
+  const auto nodes = el.nodes;
+  const auto flag = inside_flag_;
+  Kokkos::parallel_for(
+      "contact_inside_flag", Kokkos::RangePolicy<ExecSpace>(0, n), KOKKOS_LAMBDA(const LO k) {
+        Vec<dim> v[dim + 1];
+        for (int a = 0; a <= dim; ++a) v[a] = load_vec<dim>(x, nodes(pairs(k, 1), a));
+        if (point_in_simplex<dim>(load_vec<dim>(xp, pairs(k, 0)), v, 0.0)) flag(pairs(k, 0)) = 1;  // same value: no race
+      });
+  LO count = 0;
+  Kokkos::parallel_reduce(
+      "contact_inside_count", Kokkos::RangePolicy<ExecSpace>(0, np),
+      KOKKOS_LAMBDA(const LO q, LO& acc) { acc += flag(q); }, count);
+  return count;
+}
+
+template <int dim>
 LO Contact<dim>::particle_inside_at(ConstDofView x) const {
   Kokkos::View<double*, MemSpace> xp("contact_inside_xp", static_cast<std::size_t>(ps_.size()) * dim);
   interpolate_particles(ps_, x, xp);

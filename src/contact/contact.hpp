@@ -38,6 +38,8 @@ class Contact {
   // particles from the system DOFs x of this step (a debug check of iterates).
   LO particle_inside(ConstDofView xp, ConstDofView x) const;
   LO particle_inside_at(ConstDofView x) const;
+  // How many particles (xp, node-interleaved) lie inside or on an FEM element.
+  LO count_inside(ConstDofView xp, ConstDofView x) const;
 
   // Per step, after the MPM grid is activated: stencils and pairs near x^n.
   void begin_step(const MpmBodies<dim>& mpm, ConstDofView x);
@@ -76,6 +78,7 @@ class Contact {
   mutable SpatialHash<dim> element_hash_;
   mutable Boxes<dim> element_boxes_, point_boxes_;
   mutable Kokkos::View<LO* [2], MemSpace> inside_pairs_;
+  mutable Kokkos::View<int*, MemSpace> inside_flag_;
 };
 
 }  // namespace bfemp

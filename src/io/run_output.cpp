@@ -16,7 +16,8 @@ std::vector<std::string> diagnostics_columns(const std::vector<std::string>& bod
       "momentum_y", "momentum_z", "newton_iters", "linear_iters", "min_J", "assembly_s", "solve_s",
       "step_s", "active_grid_nodes", "contact_pairs", "min_distance", "barrier_energy", "friction_iters",
       "ccd_alpha_min", "contact_force_x", "contact_force_y", "contact_force_z", "contact_lo_x",
-      "contact_lo_y", "contact_lo_z", "contact_hi_x", "contact_hi_y", "contact_hi_z"};
+      "contact_lo_y", "contact_lo_z", "contact_hi_x", "contact_hi_y", "contact_hi_z", "penetrations",
+      "penetration_depth"};
   for (const std::string& b : bodies)
     for (const char* f : body_column_fields()) cols.push_back(b + "." + f);
   return cols;
@@ -36,7 +37,7 @@ std::vector<double> diagnostics_row(const StepReport& r) {
           static_cast<double>(r.contact_pairs), r.min_distance, r.barrier_energy,
           static_cast<double>(r.friction_iters), r.ccd_alpha_min, r.contact_force[0], r.contact_force[1],
           r.contact_force[2], r.contact_lo[0], r.contact_lo[1], r.contact_lo[2], r.contact_hi[0],
-          r.contact_hi[1], r.contact_hi[2]};
+          r.contact_hi[1], r.contact_hi[2], static_cast<double>(r.penetrations), r.penetration_depth};
   for (const BodyReport& b : r.bodies) {
     const double v[] = {b.mass,        b.com[0],      b.com[1], b.com[2], b.velocity[0],
                         b.velocity[1], b.velocity[2], b.kinetic, b.elastic};
@@ -57,7 +58,7 @@ RunOutput<dim>::RunOutput(const std::string& dir, const Scene& scene, const Simu
                           const OutputResume* resume)
     : dir_(prepare_dir(dir)), xdmf_(dir + "/bfemp.xdmf", "bfemp.h5") {
   const std::set<std::string> ints = {"step", "newton_iters", "linear_iters", "active_grid_nodes", "contact_pairs",
-                                      "friction_iters"};
+                                      "friction_iters", "penetrations"};
   if (resume) {
     h5_ = std::make_unique<Hdf5FrameWriter>(dir + "/bfemp.h5", resume->frames);
     csv_ = std::make_unique<DiagnosticsCsv>(dir + "/diagnostics.csv", diagnostics_columns(sim.body_names()), ints, resume->step);

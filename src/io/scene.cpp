@@ -247,6 +247,22 @@ void build_mpm(const Scene& scene, const std::vector<std::string>& mat_names, Si
     ls.kind = type == "box" ? LevelSetKind::Box : type == "sine" ? LevelSetKind::Sine : LevelSetKind::HalfPlane;
     ls.slip = l.get<bool>("slip");
     ls.velocity = vec3(l.get<Array<double>>("velocity"), dim, key + "/velocity");
+    const auto& motion = l.sublist("Motion");
+    if (motion.numParams() > 0 && !l.get<Array<double>>("velocity").empty())
+      bad(key + "/velocity", list(l.get<Array<double>>("velocity")), "no velocity when Motion segments are given");
+    if (motion.numParams() > LevelSet::kMaxSegments)
+      bad(key + "/Motion", std::to_string(motion.numParams()) + " segments",
+          "at most " + std::to_string(LevelSet::kMaxSegments));
+    double t_end = 0;
+    for (auto sit = motion.begin(); sit != motion.end(); ++sit) {
+      const std::string skey = key + "/Motion/" + motion.name(sit);
+      const MotionSegment seg = segment_from(motion.sublist(motion.name(sit)), dim, skey);
+      if (seg.type == MotionType::Rotation) bad(skey + "/type", "'rotation'", "velocity or fixed (level sets translate)");
+      t_end += seg.duration;
+      ls.seg_end[ls.segments] = t_end;
+      for (int c = 0; c < 3; ++c) ls.seg_velocity[ls.segments][c] = seg.type == MotionType::Velocity ? seg.velocity[c] : 0.0;
+      ++ls.segments;
+    }
     if (ls.kind == LevelSetKind::HalfPlane) {
       ls.point = vec3(l.get<Array<double>>("point"), dim, key + "/point");  // default: origin
       const Vec<dim> n = vecd<dim>(l.get<Array<double>>("normal"), key + "/normal");
@@ -378,6 +394,7 @@ SimulationSetup<dim> build_setup(const Scene& scene) {
   if (setup.mpm && !setup.bodies.empty() && p.sublist("Contact").get<bool>("enabled")) setup.contact = contact_from(p);
   const auto& time = p.sublist("Time");
   setup.dt = time.get<double>("dt");
+  setup.count_penetrations = p.sublist("Output").get<bool>("count penetrations");
   if (time.get<std::string>("integrator") == "newmark") {
     const auto& nm = time.sublist("Newmark");
     setup.integrator = TimeIntegrator::newmark(nm.get<double>("alpha"), nm.get<double>("beta"), nm.get<double>("gamma"));

@@ -105,6 +105,10 @@ ParameterList level_set_schema() {
   l.set("wavelength", 0.0, "sine: wavelength (m), > 0 for type sine");
   choice(l, "solid", "below", "sine: the solid side of the contour", tuple<std::string>("below", "above"));
   l.set("velocity", Array<double>(), "m/s, constant motion of the boundary (default 0)");
+  l.sublist("Motion", false,
+            "piecewise motion instead of velocity: segments of type velocity or fixed, in name order; "
+            "at rest after the last")
+      .disableRecursiveValidation();
   return l;
 }
 
@@ -156,6 +160,9 @@ Teuchos::RCP<const ParameterList> scene_schema() {
   auto& out = pl->sublist("Output", false, "output frames and progress");
   out.set("frame every", 10, "steps between HDF5/XDMF frames (frame 0 is the initial state)");
   out.set("progress every", 10, "steps between progress lines (0: none)");
+  out.set("count penetrations", false,
+          "per step, count the particles inside an FEM element or a level set's solid and the deepest "
+          "level-set penetration (diagnostics.csv penetrations, penetration_depth; costs a spatial hash per step)");
   out.set("checkpoint every", 0,
           "steps between restart checkpoints (checkpoint.h5; 0: only at the end and on SIGINT/SIGTERM), >= 0");
   pl->sublist("Materials", false, "named materials").disableRecursiveValidation();

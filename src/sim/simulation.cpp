@@ -16,14 +16,14 @@ using View1 = Kokkos::View<double*, MemSpace>;
 // shrinks, so steps do not reallocate.
 template <int dim>
 struct Simulation<dim>::System {
-  View1 x, v, v_old, a, x_hat, target, mass, work, x_ref;
+  View1 x, v, v_old, a, x_hat, target, mass, work, x_ref, weight;
   Kokkos::View<int*, MemSpace> prescribed;
   std::size_t n = 0;
   void resize(std::size_t nd) {
     n = nd;
     if (x.extent(0) >= nd) return;
     const std::size_t cap = nd + nd / 4;
-    for (View1* w : {&x, &v, &v_old, &a, &x_hat, &target, &mass, &work, &x_ref}) *w = View1(w->label(), cap);
+    for (View1* w : {&x, &v, &v_old, &a, &x_hat, &target, &mass, &work, &x_ref, &weight}) *w = View1(w->label(), cap);
     prescribed = Kokkos::View<int*, MemSpace>("sys_prescribed", cap);
   }
   template <class V>
@@ -37,7 +37,15 @@ Simulation<dim>::Simulation(SimulationSetup<dim> setup, const Teuchos::RCP<const
     throw std::invalid_argument("time step dt = " + std::to_string(setup_.dt) + ": expected dt > 0");
   elasticity_ = std::make_unique<DeformationTerm<dim, dim + 1>>("fem elasticity", mesh_.elements);
   if (mesh_.num_cells() > 0) elasticity_->set_coloring(color_stencils<dim + 1>(mesh_.elements.nodes, mesh_.num_nodes()));
-  if (setup_.mpm) mpm_ = std::make_unique<MpmBodies<dim>>(*setup_.mpm, mesh_.elements.materials);
+  if (setup_.mpm) {
+    mpm_ = std::make_unique<MpmBodies<dim>>(*setup_.mpm, mesh_.elements.materials);
+    const auto pm = mpm_->particles().mass;
+    double m = std::numeric_limits<double>::infinity();
+    Kokkos::parallel_reduce(
+        "mpm_min_particle_mass", Kokkos::RangePolicy<ExecSpace>(0, pm.extent(0)),
+        KOKKOS_LAMBDA(const std::size_t q, double& acc) { acc = pm(q) < acc ? pm(q) : acc; }, Kokkos::Min<double>(m));
+    mpm_min_particle_mass_ = std::isfinite(m) ? m : 0.0;
+  }
   newton_ = std::make_unique<NewtonSolver<dim>>(comm, setup_.linear_solver, setup_.newton);
   sys_ = std::make_unique<System>();
   if (setup_.level_sets.size() > static_cast<std::size_t>(kMaxLevelSets))
@@ -168,13 +176,11 @@ void Simulation<dim>::prescribed_velocities(double t1) {
 // its gradient vanish: 9 particles per cell in 2D, 27 in 3D) carry no mass
 // and no stiffness, so the Newton matrix would be singular there. They take
 // no part in any transfer; hold them in place (prescribed, v = 0, mass 0).
-// "No mass": below 1e-8 of the heaviest node. Not just exact zeros: once such
-// a particle moves by delta dx its weight there is delta^2 / 2 (1e-8 for a
-// displacement of 1.4e-4 dx), and a node of relative mass 1e-12..1e-8 has a
-// stiffness so small that the Newton direction there is round-off: Newton
-// stalled at |p|/dt ~ 5e-7 m/s (Brazilian disk, 9 per cell, eps_d = 1e-8,
-// step 2). Holding a node of relative mass w moves its particles by O(w) of
-// their velocity (1e-7 relative at most), far inside the Newton tolerance.
+// "No mass": below 1e-12 of the heaviest node (round-off of a zero weight).
+// Nodes just above it (a cell-centre particle that moved by delta dx reaches
+// them with weight delta^2 / 2) stay free, so momentum is kept exactly; the
+// Newton convergence test weighs them by their mass (IncrementalPotential::
+// weight), since their direction is round-off.
 namespace {
 void hold_massless_grid_nodes(std::size_t first, std::size_t n, View1 x, View1 v, View1 mass, View1 target,
                               Kokkos::View<int*, MemSpace> pres) {
@@ -182,7 +188,7 @@ void hold_massless_grid_nodes(std::size_t first, std::size_t n, View1 x, View1 v
   Kokkos::parallel_reduce(
       "grid_mass_max", Kokkos::RangePolicy<ExecSpace>(first, n),
       KOKKOS_LAMBDA(const std::size_t i, double& m) { m = mass(i) > m ? mass(i) : m; }, Kokkos::Max<double>(mmax));
-  const double floor = 1e-8 * mmax;
+  const double floor = 1e-12 * mmax;
   Kokkos::parallel_for(
       "grid_hold_massless", Kokkos::RangePolicy<ExecSpace>(first, n), KOKKOS_LAMBDA(const std::size_t i) {
         if (mass(i) > floor) return;
@@ -262,6 +268,15 @@ StepReport Simulation<dim>::step() {
   if (motions_.size() > 0) apply_prescribed_targets(t1, target);
 
   IncrementalPotential ip{xhat, mass, pres, target, h, dt};
+  if (mpm_) {
+    auto w = System::head(S.weight, nd);
+    const double m_ref = mpm_min_particle_mass_;
+    Kokkos::parallel_for(
+        "newton_weight", Kokkos::RangePolicy<ExecSpace>(0, nd), KOKKOS_LAMBDA(const std::size_t i) {
+          w(i) = i < nfd ? 1.0 : (mass(i) >= m_ref ? 1.0 : mass(i) / m_ref);
+        });
+    ip.weight = w;
+  }
   NewtonStats ns;
   int friction_iters = 0;
   try {
@@ -322,8 +337,42 @@ StepReport Simulation<dim>::step() {
     r.contact_eval_s = contact_report.timings.evaluation_s;
     r.contact_ccd_s = contact_report.timings.ccd_s;
   }
+  if (setup_.count_penetrations && mpm_) count_penetrations(r);
   r.step_s = timer.seconds();
   return r;
+}
+
+template <int dim>
+void Simulation<dim>::count_penetrations(StepReport& r) const {
+  const auto& p = mpm_->particles();
+  const LO np = static_cast<LO>(p.size());
+  Kokkos::View<double*, MemSpace> xp("penetration_xp", static_cast<std::size_t>(np) * dim);
+  auto px = p.x;
+  Kokkos::parallel_for(
+      "penetration_xp", Kokkos::RangePolicy<ExecSpace>(0, np), KOKKOS_LAMBDA(const LO q) {
+        for (int c = 0; c < dim; ++c) xp(q * dim + c) = px(q, c);
+      });
+  long fem_count = 0;
+  if (contact_) fem_count = contact_->count_inside(xp, x_);
+  const LevelSetList ls = level_sets_;
+  const double t = time_;
+  long ls_count = 0;
+  double depth = 0;
+  Kokkos::parallel_reduce(
+      "penetration_level_sets", Kokkos::RangePolicy<ExecSpace>(0, np),
+      KOKKOS_LAMBDA(const LO q, long& n, double& d) {
+        Vec<dim> xq;
+        for (int c = 0; c < dim; ++c) xq(c) = px(q, c);
+        double phi = 1e300;
+        for (int k = 0; k < ls.count; ++k) phi = std::fmin(phi, ls.sets[k].template phi<dim>(xq, t));
+        if (phi < 0) {
+          ++n;
+          d = -phi > d ? -phi : d;
+        }
+      },
+      ls_count, Kokkos::Max<double>(depth));
+  r.penetrations = fem_count + ls_count;
+  r.penetration_depth = depth;
 }
 
 // Algorithm 1 lines 5-10: lag friction at x^n, minimise, re-lag at the

@@ -6,6 +6,7 @@
 // backward-Euler update, prescribed motion, P2G/G2P, per-step diagnostics.
 #include <Teuchos_ParameterList.hpp>
 #include <array>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <vector>
@@ -34,6 +35,7 @@ struct SimulationSetup {
   double dt = 1e-3;
   NewtonParams newton;
   Teuchos::ParameterList linear_solver;                 // resolved "Linear Solver" list
+  bool count_penetrations = false;                      // StepReport::penetrations each step
 };
 
 // One body's share of a StepReport: mass, centre of mass (mass-weighted mean
@@ -62,6 +64,11 @@ struct StepReport {
   std::array<double, 3> contact_force{0, 0, 0};
   // Box of the particles in contact with that body (NaN without pairs).
   std::array<double, 3> contact_lo{0, 0, 0}, contact_hi{0, 0, 0};
+  // With SimulationSetup::count_penetrations: particles inside an FEM element
+  // or inside a level set's solid at the end of the step, and the deepest
+  // level-set penetration (m); -1 and NaN when not counted.
+  long penetrations = -1;
+  double penetration_depth = std::numeric_limits<double>::quiet_NaN();
   double contact_broad_phase_s = 0, contact_eval_s = 0, contact_ccd_s = 0;
   double step_s = 0;
   std::vector<BodyReport> bodies;  // in the order of Simulation::body_names()
@@ -127,6 +134,7 @@ class Simulation {
   struct System;
   void apply_prescribed_targets(double t, Kokkos::View<double*, MemSpace> target) const;
   void prescribed_velocities(double t1);
+  void count_penetrations(StepReport& r) const;
   NewtonStats minimize_with_friction(const IncrementalPotential& ip, Kokkos::View<double*, MemSpace> x,
                                      Kokkos::View<double*, MemSpace> x_ref, double s, int& iterations);
 
@@ -143,6 +151,7 @@ class Simulation {
   DeviceMotions motions_;  // prescribed nodes and their segments, on the device
   double time_ = 0;
   long step_ = 0;
+  double mpm_min_particle_mass_ = 0;  // the weight scale of the Newton convergence test
 };
 
 }  // namespace bfemp

@@ -224,18 +224,20 @@ NewtonStats NewtonSolver<dim>::minimize(const IncrementalPotential& ip, View1 x)
 
     timer.reset();
     double p_inf = 0;
+    const auto wgt = ip.weight;
+    const bool has_w = wgt.extent(0) > 0;
     Kokkos::parallel_reduce(
         "newton_dir_norm", Kokkos::RangePolicy<ExecSpace>(0, x.extent(0)),
         KOKKOS_LAMBDA(const LO i, double& acc) {
           if (pres(i)) dir(i) = dxp(i);  // exact, not the solver's rounding of it
-          acc = std::fmax(acc, std::fabs(dir(i)));
+          acc = std::fmax(acc, std::fabs(dir(i)) * (has_w ? wgt(i) : 1.0));
         },
         Kokkos::Max<double>(p_inf));
     if (m.dofs.slip().count() > 0) {  // exact normal part at slip nodes, as for prescribed DOFs
       m.dofs.slip().fix_direction(dir);
       Kokkos::parallel_reduce(
           "newton_dir_norm_slip", Kokkos::RangePolicy<ExecSpace>(0, x.extent(0)),
-          KOKKOS_LAMBDA(const LO i, double& acc) { acc = std::fmax(acc, std::fabs(dir(i))); },
+          KOKKOS_LAMBDA(const LO i, double& acc) { acc = std::fmax(acc, std::fabs(dir(i)) * (has_w ? wgt(i) : 1.0)); },
           Kokkos::Max<double>(p_inf));
     }
     if (!std::isfinite(p_inf))
@@ -262,14 +264,14 @@ NewtonStats NewtonSolver<dim>::minimize(const IncrementalPotential& ip, View1 x)
           "newton_dir_norm_tight", Kokkos::RangePolicy<ExecSpace>(0, x.extent(0)),
           KOKKOS_LAMBDA(const LO i, double& acc) {
             if (pres(i)) dir(i) = dxp(i);
-            acc = std::fmax(acc, std::fabs(dir(i)));
+            acc = std::fmax(acc, std::fabs(dir(i)) * (has_w ? wgt(i) : 1.0));
           },
           Kokkos::Max<double>(p_inf));
       if (m.dofs.slip().count() > 0) {
         m.dofs.slip().fix_direction(dir);
         Kokkos::parallel_reduce(
             "newton_dir_norm_tight_slip", Kokkos::RangePolicy<ExecSpace>(0, x.extent(0)),
-            KOKKOS_LAMBDA(const LO i, double& acc) { acc = std::fmax(acc, std::fabs(dir(i))); },
+            KOKKOS_LAMBDA(const LO i, double& acc) { acc = std::fmax(acc, std::fabs(dir(i)) * (has_w ? wgt(i) : 1.0)); },
             Kokkos::Max<double>(p_inf));
       }
       converged = p_inf / ip.dt < m.params.eps_d;

@@ -44,6 +44,13 @@ struct IncrementalPotential {
   Kokkos::View<const double*, MemSpace> target;  // prescribed DOF positions at t^{n+1}
   double h = 0;                                  // 2 alpha beta dt^2
   double dt = 0;
+  // Optional per-DOF weights of the convergence test |p|_inf / dt < eps_d:
+  // DOF i counts as weight(i) |p_i| (empty: 1 everywhere). The MPM grid uses
+  // min(1, m_i / m_particle,min), a bound of the largest particle weight node
+  // i carries: a node reached by particles only with weights of 1e-12..1e-8
+  // (9 / 27 per cell, particles just off the cell centre) has so little mass
+  // and stiffness that its direction is round-off, and it moves no particle.
+  Kokkos::View<const double*, MemSpace> weight;
 };
 
 template <int dim>

@@ -72,7 +72,7 @@ void SlipConstraints<dim>::build(const LevelSetList& ls, double t, double dt, st
           if (!set.slip || set.template phi<dim>(xi, t) > 0 || r == dim) continue;
           const Vec<dim> nrm = set.template unit_normal<dim>(xi, t);
           double ds = 0;
-          for (int c = 0; c < dim; ++c) ds += dt * nrm(c) * set.velocity[c];
+          for (int c = 0; c < dim; ++c) ds += dt * nrm(c) * set.step_velocity(c, t, dt);
           Vec<dim> res = nrm;
           double known = 0;
           for (int j = 0; j < r; ++j) {

@@ -201,7 +201,8 @@ TEST(Extreme, NineParticlesPerCellTightToleranceConverges) {
   // The Brazilian disk (A3) at 9 per cell with eps_d = 1e-8: after step 1 the
   // cell-centre particles have moved by ~1e-6 dx and reach the far nodes with
   // weights 1e-12..1e-8; Newton stalled at |p|/dt ~ 5e-7 m/s in step 2 (300
-  // iterations) until such nodes were held like massless ones.
+  // iterations: the direction at those nodes is round-off) until the
+  // convergence test weighed grid nodes by their mass.
   const std::string disk = std::string(BFEMP_SOURCE_DIR) + "/inputs/a3_brazilian_disk.yaml";
   const Outcome o = run_case(disk, {"MPM/particles per cell=9", "Time/end time=0.04",
                                     "FEM Bodies/bottom/Mesh/center=[0.0, -1.0417167]",

@@ -22,9 +22,8 @@
 //    than the free release. A sticky boundary drags the top particles up with
 //    it (0.08 m of travel while rising).
 // Level-set comparison: the same motion with a slip level set of the same
-// sine shape (solid above) on the grid. Level sets move only at one constant
-// velocity, so the run is chained as three simulations (down, left, up), the
-// particle state (x, v, F, C) carried from one to the next. It penetrates
+// sine shape (solid above) on the grid, moving down, left and up in one run
+// (piecewise level-set motion, the scene key Level Sets/<name>/Motion). It penetrates
 // (particles inside the level-set solid: count and depth reported, asserted
 // > 0 during the press) and the rising level set does positive work on the
 // box in some step (reported, asserted > 0): the grid constraint
@@ -211,90 +210,70 @@ TEST(ContactSinePress, LevelSetSlipSinePenetratesAndAdheres) {
   const Scene scene = load_scene(scene_file);
   const double dt = build_setup<2>(scene).dt;
   // The same scene without the FEM body, the boundary a slip level set of the
-  // same shape on the grid; one simulation per motion segment.
-  auto make = [&](double height, double amplitude, std::array<double, 3> velocity) {
-    SimulationSetup<2> s = build_setup<2>(scene);  // fresh particle Views (a copy would share them)
-    s.bodies.clear();
-    s.initial_velocity.clear();
-    s.motions.clear();
-    s.contact.reset();
-    LevelSet ls;
-    ls.name = "sine";
-    ls.kind = LevelSetKind::Sine;
-    ls.slip = true;
-    ls.solid_above = true;
-    ls.height = height;
-    ls.amplitude = amplitude;
-    ls.wavelength = kWave;
-    ls.velocity = velocity;
-    s.level_sets.push_back(ls);
-    return std::make_unique<Simulation<2>>(std::move(s), fixtures::comm());
-  };
-  struct Segment {
-    double height, amplitude;
-    std::array<double, 3> velocity;
-    double duration;
-  };
-  // Left by half a wavelength turns A cos(k x) into -A cos(k x).
-  const Segment segments[3] = {{kY0, kA, {0.0, -1.0, 0.0}, kDown},
-                               {kY0 - kDown, kA, {-1.0, 0.0, 0.0}, kLeft},
-                               {kY0 - kDown, -kA, {0.0, 1.0, 0.0}, kUp}};
-  std::unique_ptr<Simulation<2>> prev;
+  // same shape on the grid, moving down, left and up in one simulation
+  // (piecewise level-set motion; left by half a wavelength turns A cos(k x)
+  // into -A cos(k x) through the offset).
+  SimulationSetup<2> setup = build_setup<2>(scene);
+  setup.bodies.clear();
+  setup.initial_velocity.clear();
+  setup.motions.clear();
+  setup.contact.reset();
+  LevelSet ls;
+  ls.name = "sine";
+  ls.kind = LevelSetKind::Sine;
+  ls.slip = true;
+  ls.solid_above = true;
+  ls.height = kY0;
+  ls.amplitude = kA;
+  ls.wavelength = kWave;
+  ls.segments = 3;
+  const double ends[3] = {kDown, kDown + kLeft, kDown + kLeft + kUp};
+  const double vel[3][3] = {{0.0, -1.0, 0.0}, {-1.0, 0.0, 0.0}, {0.0, 1.0, 0.0}};
+  for (int k = 0; k < 3; ++k) {
+    ls.seg_end[k] = ends[k];
+    for (int c = 0; c < 3; ++c) ls.seg_velocity[k][c] = vel[k][c];
+  }
+  setup.level_sets.push_back(ls);
+  auto sim = std::make_unique<Simulation<2>>(std::move(setup), fixtures::comm());
+  const Particles<2>& p = sim->mpm()->particles();
   std::vector<double> y_rest;
+  {
+    const HostParticles h = host_particles(p);
+    for (std::size_t i = 0; i < p.size(); ++i) y_rest.push_back(h.x(i, 1));
+  }
   long max_inside[3] = {0, 0, 0}, inside_end = 0, dragged_end = 0;
   double max_depth[3] = {0, 0, 0};
   double rise_end = -1e300, e_up_start = 0, e_up_end = 0, max_energy_rise = -1e300, e_prev = 0, vy_up_max = -1e300;
-  for (int seg = 0; seg < 3; ++seg) {
-    auto sim = make(segments[seg].height, segments[seg].amplitude, segments[seg].velocity);
-    const Particles<2>& p = sim->mpm()->particles();
-    if (prev) {
-      const Particles<2>& q = prev->mpm()->particles();
-      ASSERT_EQ(p.size(), q.size());
-      Kokkos::deep_copy(p.x, q.x);
-      Kokkos::deep_copy(p.v, q.v);
-      Kokkos::deep_copy(p.F, q.F);
-      Kokkos::deep_copy(p.C, q.C);
-    } else {
-      const HostParticles h = host_particles(p);
-      for (std::size_t i = 0; i < p.size(); ++i) y_rest.push_back(h.x(i, 1));
-    }
-    LevelSet ls;
-    ls.kind = LevelSetKind::Sine;
-    ls.solid_above = true;
-    ls.height = segments[seg].height;
-    ls.amplitude = segments[seg].amplitude;
-    ls.wavelength = kWave;
-    ls.velocity = segments[seg].velocity;
-    if (seg == 2) e_prev = e_up_start = particle_kinetic(host_particles(p)) + sim->diagnostics().elastic;
-    const int n_steps = static_cast<int>(std::lround(segments[seg].duration / dt));
-    for (int n = 0; n < n_steps; ++n) {
-      const StepReport r = sim->step();
-      const HostParticles h = host_particles(p);
-      long inside = 0, dragged = 0;
-      double depth = 0, rise = -1e300, vy = -1e300;
-      for (std::size_t i = 0; i < p.size(); ++i) {
-        const double phi = ls.phi<2>(Vec<2>(h.x(i, 0), h.x(i, 1)), sim->time());
-        if (phi < 0) {
-          ++inside;
-          depth = std::max(depth, -phi);
-        }
-        rise = std::max(rise, h.x(i, 1) - y_rest[i]);
-        if (h.x(i, 1) - y_rest[i] > 0.01) ++dragged;
-        vy = std::max(vy, h.v(i, 1));
+  const long n_steps = std::lround(ends[2] / dt);
+  const long up_from = std::lround(ends[1] / dt);
+  for (long n = 0; n < n_steps; ++n) {
+    const int seg = n < std::lround(ends[0] / dt) ? 0 : n < up_from ? 1 : 2;
+    if (n == up_from) e_prev = e_up_start = particle_kinetic(host_particles(p)) + sim->diagnostics().elastic;
+    const StepReport r = sim->step();
+    const HostParticles h = host_particles(p);
+    long inside = 0, dragged = 0;
+    double depth = 0, rise = -1e300, vy = -1e300;
+    for (std::size_t i = 0; i < p.size(); ++i) {
+      const double phi = ls.phi<2>(Vec<2>(h.x(i, 0), h.x(i, 1)), sim->time());
+      if (phi < 0) {
+        ++inside;
+        depth = std::max(depth, -phi);
       }
-      max_inside[seg] = std::max(max_inside[seg], inside);
-      max_depth[seg] = std::max(max_depth[seg], depth);
-      if (seg == 2) {
-        const double e = particle_kinetic(h) + r.elastic;
-        max_energy_rise = std::max(max_energy_rise, e - e_prev);
-        e_prev = e_up_end = e;
-        vy_up_max = std::max(vy_up_max, vy);
-        inside_end = inside;
-        dragged_end = dragged;
-        rise_end = std::max(rise_end, rise);
-      }
+      rise = std::max(rise, h.x(i, 1) - y_rest[i]);
+      if (h.x(i, 1) - y_rest[i] > 0.01) ++dragged;
+      vy = std::max(vy, h.v(i, 1));
     }
-    prev = std::move(sim);
+    max_inside[seg] = std::max(max_inside[seg], inside);
+    max_depth[seg] = std::max(max_depth[seg], depth);
+    if (seg == 2) {
+      const double e = particle_kinetic(h) + r.elastic;
+      max_energy_rise = std::max(max_energy_rise, e - e_prev);
+      e_prev = e_up_end = e;
+      vy_up_max = std::max(vy_up_max, vy);
+      inside_end = inside;
+      dragged_end = dragged;
+      rise_end = std::max(rise_end, rise);
+    }
   }
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   std::cout << "sine press (level-set slip sine): particles inside the solid, max count / max depth: down "

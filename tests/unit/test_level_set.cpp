@@ -95,3 +95,41 @@ TEST(LevelSet, HalfPlaneNormal) {
   EXPECT_EQ(n, Vec<2>(-s, c));
   EXPECT_NEAR(h.phi<2>(Vec<2>(1.0 - s, 2.0 + c), 0.0), 1.0, 1e-15);
 }
+
+// Piecewise motion (A2: down, left, up at 1 m/s for 0.04, 0.05, 0.08 s, then
+// at rest): the offset integrates the segments, the step velocity is the mean
+// over a step, exact when a segment ends inside it, and a half-plane moves
+// with the offset.
+TEST(LevelSet, PiecewiseMotionIntegratesTheSegments) {
+  LevelSet s;
+  s.kind = LevelSetKind::HalfPlane;
+  s.normal = {0, -1, 0};  // solid above y = 0.5
+  s.point = {0, 0.5, 0};
+  s.segments = 3;
+  const double ends[] = {0.04, 0.09, 0.17}, vel[][3] = {{0, -1, 0}, {-1, 0, 0}, {0, 1, 0}};
+  for (int k = 0; k < 3; ++k) {
+    s.seg_end[k] = ends[k];
+    for (int c = 0; c < 3; ++c) s.seg_velocity[k][c] = vel[k][c];
+  }
+  EXPECT_NEAR(s.offset(1, 0.02), -0.02, 1e-15);
+  EXPECT_NEAR(s.offset(0, 0.02), 0.0, 1e-15);
+  EXPECT_NEAR(s.offset(0, 0.06), -0.02, 1e-15);
+  EXPECT_NEAR(s.offset(1, 0.06), -0.04, 1e-15);
+  EXPECT_NEAR(s.offset(1, 0.17), 0.04, 1e-15);
+  EXPECT_NEAR(s.offset(1, 0.5), 0.04, 1e-15) << "at rest after the last segment";
+  EXPECT_NEAR(s.offset(0, 0.5), -0.05, 1e-15);
+  // A step of 0.01 s across the end of the down segment: half down, half left.
+  EXPECT_NEAR(s.step_velocity(1, 0.035, 0.01), -0.5, 1e-12);
+  EXPECT_NEAR(s.step_velocity(0, 0.035, 0.01), -0.5, 1e-12);
+  EXPECT_NEAR(s.step_velocity(1, 0.3, 0.01), 0.0, 1e-15);
+  // The plane y = 0.5 + offset: phi = -(y - y_plane).
+  const Vec<2> x(0.0, 0.47);
+  EXPECT_NEAR(s.phi<2>(x, 0.02), -(0.47 - 0.48), 1e-15);
+  EXPECT_NEAR(s.phi<2>(x, 0.17), -(0.47 - 0.54), 1e-15);
+  // Without segments, the constant velocity.
+  LevelSet c = s;
+  c.segments = 0;
+  c.velocity = {0, 2, 0};
+  EXPECT_NEAR(c.offset(1, 0.3), 0.6, 1e-15);
+  EXPECT_EQ(c.step_velocity(1, 0.3, 0.1), 2.0);
+}

@@ -84,8 +84,8 @@ TEST(Probes, ContactWindowEnergyLossMomentumDriftAndMaxima) {
   EXPECT_NEAR(evaluate_probe("energy_lost_pct", t), 8.57, 1e-12);
   EXPECT_NEAR(evaluate_probe("energy_lost_pct:from=0,to=0.4", t), 5.0, 1e-12);
   // |p| of body b at t = 0: 2 kg x 40 m/s.
-  // (80 + 4e-6) - 80 carries the round-off of 80: 80 eps / 80 relative.
-  EXPECT_NEAR(evaluate_probe("momentum_drift:axis=x,relative_to=b", t), 4e-6 / 80.0, 4e-15 / 80.0);
+  // (80 + 4e-6) - 80 carries the round-off of 80 (ulp 1.4e-14): 2 ulp / 80.
+  EXPECT_NEAR(evaluate_probe("momentum_drift:axis=x,relative_to=b", t), 4e-6 / 80.0, 3e-14 / 80.0);
   EXPECT_DOUBLE_EQ(evaluate_probe("sum:column=newton_iters", t), 33.0);
   EXPECT_DOUBLE_EQ(evaluate_probe("max:column=contact_pairs,from=0.6", t), 0.0);
   EXPECT_DOUBLE_EQ(evaluate_probe("min:column=kinetic", t), 50.0);

@@ -225,6 +225,20 @@ bfemp:
                  {"Level Sets/walls/box max", "> box min"});
   expect_message(error_of(with("velocity: [0.0, -1.0]", "velocity: [-1.0]")),
                  {"Level Sets/waves/velocity", "2 components"});
+  // Piecewise motion: accepted, and refused with a velocity too or a rotation.
+  const std::string seg = "incline: {type: half-plane, slip: true, point: [0.0, 0.0], normal: [-0.5, 1.0], Motion: "
+                          "{a: {type: velocity, velocity: [0.0, -1.0], duration: 0.04}, b: {type: fixed, duration: 0.1}}}";
+  const std::string incline = "incline: {type: half-plane, slip: true, point: [0.0, 0.0], normal: [-0.5, 1.0]}";
+  EXPECT_EQ(error_of(with(incline, seg)), "");
+  std::string both = seg;
+  both.replace(both.find("Motion"), 6, "velocity: [1.0, 0.0], Motion");
+  expect_message(error_of(with(incline, both)), {"Level Sets/incline/velocity", "no velocity when Motion"});
+  std::string rot = seg;
+  rot.replace(rot.find("type: fixed"), 11, "type: rotation");
+  expect_message(error_of(with(incline, rot)), {"Level Sets/incline/Motion/b/type", "rotation", "velocity or fixed"});
+  std::string neg = seg;
+  neg.replace(neg.find("duration: 0.04"), 14, "duration: -1.0");
+  expect_message(error_of(with(incline, neg)), {"Level Sets/incline/Motion/a/duration", "positive"});
   // Particles that start inside a level set's solid.
   expect_message(error_of(with("height: 0.9", "height: 0.5")),
                  {"MPM body 'block'", "inside the solid of level set 'waves'", "Level Sets/waves"});
