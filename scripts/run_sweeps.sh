@@ -67,8 +67,8 @@ fi
 if [[ ",$only," == *",a1,"* ]]; then
   a1="$repo/inputs/contact_rings.yaml"
   probe=(--probe energy_lost_pct --probe "momentum_drift:axis=x,relative_to=left" --reference 8.57)
-  sweep a1_dt "$a1" --set "Time/end time=0.4" --vary "Time/dt=2.0e-3,1.0e-3,5.0e-4" "${probe[@]}"
-  sweep a1_transfer "$a1" --set "Time/end time=0.4" --vary "MPM/transfer=APIC,FLIP,PIC" "${probe[@]}"
-  sweep a1_solver "$a1" --set "Time/end time=0.4" --vary "Linear Solver/type=Cholmod,KLU2,CG" "${probe[@]}"
+  sweep a1_dt "$a1" --set "Time/end time=0.4" --set "MPM/when particles leave=extend" --vary "Time/dt=2.0e-3,1.0e-3,5.0e-4" "${probe[@]}"
+  sweep a1_transfer "$a1" --set "Time/end time=0.4" --set "MPM/when particles leave=extend" --vary "MPM/transfer=APIC,FLIP,PIC" "${probe[@]}"
+  sweep a1_solver "$a1" --set "Time/end time=0.4" --set "MPM/when particles leave=extend" --vary "Linear Solver/type=Cholmod,KLU2,CG" "${probe[@]}"
 fi
 echo "run_sweeps.sh: wrote $out"

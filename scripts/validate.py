@@ -43,12 +43,17 @@ def scenes(size):
     s = {}
     s["A1"] = {
         "title": "A1 colliding rings (section 6.1, Figs. 6-7)",
-        # The ci scene ends in contact (its test); the report runs it past separation.
+        # The ci scene ends in contact (its test); the report runs it past
+        # separation, growing the grid as the rings fly apart.
         "runs": [(run, scene_path(size, "contact_rings.yaml" if size == "ci" else "a1_rings.yaml"),
-                  ["MPM/transfer=" + scheme] + (["Time/end time=0.4"] if size == "ci" else []))
+                  ["MPM/transfer=" + scheme] +
+                  (["Time/end time=0.4", "MPM/when particles leave=extend"] if size == "ci" else []))
                  for run, scheme in (("A1_apic", "APIC"), ("A1_flip", "FLIP"))],
         "bands": [],
         "plot": plot_a1,
+        "notes": {"ci": ["the energy lost during contact is chaotic at this size: the same APIC run at 2 threads "
+                         "gave 13.9, 15.7, 16.9 and 17.2 % (contact pairs add with atomics, and the under-resolved "
+                         "barrier amplifies the last bits; tests/scene/test_contact_rings_energy.cpp)"]},
     }
     for run, lost in (("A1_apic", 8.57), ("A1_flip", 9.67)):
         s["A1"]["bands"] += [
@@ -85,6 +90,11 @@ def scenes(size):
                   ["Materials/disk/model=neo-hookean"])],
         "bands": [],
         "plot": plot_a3,
+        "notes": {"ci": ["at dx = 0.05 the disk's lowest particle row (|x| <= 0.1375) is the only one within dhat "
+                         "of the plate for the whole run, so the measured a never moves and the slope is meaningless "
+                         "(the band needs several rows: the paper size reaches three in 1 s)"],
+                  "paper": ["a is a staircase (rows of particles enter the dhat layer one by one: a = 0.0875, "
+                            "0.152, 0.193 m); the slope is the least-squares fit over every contact step"]},
     }
     for run in ("A3_linear", "A3_neohookean"):
         s["A3"]["bands"].append(
@@ -264,7 +274,7 @@ def main():
             else:
                 try:
                     value = probe(args.bfemp, r["dir"], spec) / scale
-                    shown = "%.6g" % value
+                    shown = "%.9g" % value
                     ok = None if check is None else (value == value and bool(check(value)))
                 except RuntimeError as e:
                     value, ok, shown = float("nan"), False, "probe failed: %s" % e
@@ -273,6 +283,8 @@ def main():
             mark = "n/a" if ok is None else ("pass" if ok else "**FAIL**")
             report.append("| %s | %s | %s | %s | %s | %s | %s | %.1f | %d |" %
                           (name, run, measure, paper, shown, band_text, mark, r["wall"], newton))
+        for note in sc.get("notes", {}).get(args.size, []):
+            notes.append("- %s: %s" % (name, note))
         if plt is not None:
             png = os.path.join(args.out, name + ".png")
             try:
