@@ -53,20 +53,21 @@ bool finite_fields(const Simulation<dim>& sim) {
   return f;
 }
 
+template <int dim = 2>
 Outcome run_case(const std::string& file, std::vector<std::string> sets, long max_steps = -1) {
   Outcome o;
   const auto t0 = std::chrono::steady_clock::now();
-  std::unique_ptr<Simulation<2>> sim;
+  std::unique_ptr<Simulation<dim>> sim;
   try {
     sets.push_back("Contact/check iterates=true");
     const Scene scene = load_scene(file, sets);
-    sim = std::make_unique<Simulation<2>>(build_setup<2>(scene), fixtures::comm());
+    sim = std::make_unique<Simulation<dim>>(build_setup<dim>(scene), fixtures::comm());
   } catch (const std::invalid_argument& e) {
     o.refused = true;
     o.message = e.what();
     return o;
   }
-  Simulation<2>& s = *sim;
+  Simulation<dim>& s = *sim;
   if (s.contact())
     s.newton().on_iterate = [&](Kokkos::View<const double*, MemSpace> x) {
       ++o.iterates;
@@ -209,6 +210,28 @@ TEST(Extreme, NineParticlesPerCellTightToleranceConverges) {
                                     "FEM Bodies/top/Mesh/center=[0.0, 1.0417167]"});
   expect_completed("ppc=9, eps_d=1e-8", o, 4);
   EXPECT_LT(o.iterates, 4 * 30) << "Newton must converge in a few iterations per step, not stall";
+}
+
+TEST(Extreme, NearDegenerateWallElement) {
+  // tests/data/sliver_wall.msh: the wall (x in [0.1, 0.3], y in [-0.4, 0.4])
+  // as 4 triangles, one a sliver along the face the disk hits: (0.1, -0.4),
+  // (0.1001, 0), (0.1, 0.4), height 1e-4 on a base of 0.8 (smallest angle
+  // 2.5e-4 rad); the contact face is its two nearly collinear edges.
+  expect_completed("sliver element",
+                   run_case(kDiskWall, {"FEM Bodies/wall/Mesh/shape=none",
+                                        "FEM Bodies/wall/Mesh/file=../tests/data/sliver_wall.msh"}), 20);
+}
+
+TEST(Extreme, TwentySevenParticlesPerCell3DInContact) {
+  // The 3D twist scene (A7) at dx 0.25 with 27 particles per cell (a particle
+  // at each cell centre: weight 0 at 1.5 dx), the shell lowered to 5 mm above
+  // the top particles (z = 1 - dx / 6) so that it presses from step 1.
+  const std::string twist = std::string(BFEMP_SOURCE_DIR) + "/inputs/a7_twist.yaml";
+  expect_completed("ppc=27 (3D)",
+                   run_case<3>(twist, {"MPM/grid spacing=0.25", "MPM/particles per cell=27",
+                                       "FEM Bodies/shell/Mesh/center=[0.0, 0.0, 1.4633]",
+                                       "FEM Bodies/shell/Mesh/element size=0.15", "Time/end time=0.03"}),
+                   3);
 }
 
 TEST(Extreme, BodiesThatStartIntersectingAreRefused) {
