@@ -52,8 +52,9 @@ def scenes(size):
         "bands": [],
         "plot": plot_a1,
         "notes": {"ci": ["the energy lost during contact is chaotic at this size: the same APIC run at 2 threads "
-                         "gave 13.9, 15.7, 16.9 and 17.2 % (contact pairs add with atomics, and the under-resolved "
-                         "barrier amplifies the last bits; tests/scene/test_contact_rings_energy.cpp)"]},
+                         "gave 13.9 to 17.2 % in five runs, while FLIP repeats 21.0931 % to every digit (so the "
+                         "APIC path adds in a thread-dependent order somewhere, and the under-resolved barrier "
+                         "amplifies the last bits; tests/scene/test_contact_rings_energy.cpp)"]},
     }
     for run, lost in (("A1_apic", 8.57), ("A1_flip", 9.67)):
         s["A1"]["bands"] += [
