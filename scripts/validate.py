@@ -143,40 +143,44 @@ def plt_or_none():
         return None
 
 
-def plot_a1(plt, out, runs):
+def two_panels(plt, runs, top, bottom, ylabels, title, out):
+    """Two stacked panels over time: top(name, d, ax) and bottom(name, d, ax) draw each run."""
     fig, axes = plt.subplots(2, 1, figsize=(7, 6), sharex=True)
     for name, d in runs.items():
-        e0 = d["total_energy"][0]
-        axes[0].plot(d["time"], [e / e0 for e in d["total_energy"]], label=name + " total")
-        axes[0].plot(d["time"], [(k + e) / e0 for k, e in zip(d["left.kinetic"], d["left.elastic"])], "--",
-                     label=name + " MPM ring")
-        axes[0].plot(d["time"], [(k + e) / e0 for k, e in zip(d["right.kinetic"], d["right.elastic"])], ":",
-                     label=name + " FEM ring")
-        p0 = d["momentum_x"][0]
-        pr = d["left.mass"][0] * abs(d["left.vel_x"][0])
-        axes[1].plot(d["time"], [(p - p0) / pr for p in d["momentum_x"]], label=name)
-    axes[0].set_ylabel("energy / E(0)")
-    axes[0].legend(fontsize=7)
-    axes[1].set_ylabel("(p_x - p_x(0)) / |p| of one ring")
+        top(name, d, axes[0])
+        bottom(name, d, axes[1])
+    for ax, label in zip(axes, ylabels):
+        ax.set_ylabel(label)
+        ax.legend(fontsize=7)
     axes[1].set_xlabel("t (s)")
-    axes[1].legend(fontsize=7)
-    fig.suptitle("A1 colliding rings: energy and momentum (paper Fig. 7)")
+    fig.suptitle(title)
     fig.tight_layout()
     fig.savefig(out, dpi=110)
+
+
+def plot_a1(plt, out, runs):
+    def energies(name, d, ax):
+        e0 = d["total_energy"][0]
+        ax.plot(d["time"], [e / e0 for e in d["total_energy"]], label=name + " total")
+        for body, style, what in (("left", "--", "MPM ring"), ("right", ":", "FEM ring")):
+            ax.plot(d["time"], [(k + e) / e0 for k, e in zip(d[body + ".kinetic"], d[body + ".elastic"])], style,
+                    label=name + " " + what)
+
+    def momentum(name, d, ax):
+        p0 = d["momentum_x"][0]
+        pr = d["left.mass"][0] * abs(d["left.vel_x"][0])
+        ax.plot(d["time"], [(p - p0) / pr for p in d["momentum_x"]], label=name)
+
+    two_panels(plt, runs, energies, momentum, ["energy / E(0)", "(p_x - p_x(0)) / |p| of one ring"],
+               "A1 colliding rings: energy and momentum (paper Fig. 7)", out)
 
 
 def plot_a2(plt, out, runs):
-    fig, axes = plt.subplots(2, 1, figsize=(7, 6), sharex=True)
-    for name, d in runs.items():
-        axes[0].plot(d["time"], d["penetrations"], label=name)
-        axes[1].plot(d["time"], [0 if x != x else x for x in d["penetration_depth"]], label=name)
-    axes[0].set_ylabel("particles inside the boundary")
-    axes[1].set_ylabel("deepest penetration (m)")
-    axes[1].set_xlabel("t (s)")
-    axes[0].legend(fontsize=7)
-    fig.suptitle("A2 sine press: BFEMP barrier vs level-set slip boundary")
-    fig.tight_layout()
-    fig.savefig(out, dpi=110)
+    two_panels(plt, runs, lambda name, d, ax: ax.plot(d["time"], d["penetrations"], label=name),
+               lambda name, d, ax: ax.plot(d["time"], [0 if x != x else x for x in d["penetration_depth"]],
+                                           label=name),
+               ["particles inside the boundary", "deepest penetration (m)"],
+               "A2 sine press: BFEMP barrier vs level-set slip boundary", out)
 
 
 def plot_a3(plt, out, runs):
@@ -201,19 +205,13 @@ def plot_a3(plt, out, runs):
 
 
 def plot_a4(plt, out, runs):
-    fig, axes = plt.subplots(2, 1, figsize=(7, 6), sharex=True)
-    for name, d in runs.items():
+    def accel(name, d, ax):
         t, v = d["time"], d["box.vel_x"]
-        axes[0].plot(t, v, label=name)
-        acc = [(v[i + 1] - v[i - 1]) / (t[i + 1] - t[i - 1]) for i in range(1, len(t) - 1)]
-        axes[1].plot(t[1:-1], acc, label=name)
-    axes[0].set_ylabel("box velocity along the slope (m/s)")
-    axes[1].set_ylabel("acceleration (m/s^2)")
-    axes[1].set_xlabel("t (s)")
-    axes[0].legend(fontsize=7)
-    fig.suptitle("A4 box on a slope (paper Fig. 12)")
-    fig.tight_layout()
-    fig.savefig(out, dpi=110)
+        ax.plot(t[1:-1], [(v[i + 1] - v[i - 1]) / (t[i + 1] - t[i - 1]) for i in range(1, len(t) - 1)], label=name)
+
+    two_panels(plt, runs, lambda name, d, ax: ax.plot(d["time"], d["box.vel_x"], label=name), accel,
+               ["box velocity along the slope (m/s)", "acceleration (m/s^2)"], "A4 box on a slope (paper Fig. 12)",
+               out)
 
 
 def git_rev():

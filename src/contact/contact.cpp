@@ -80,11 +80,7 @@ template <int dim>
 void Contact<dim>::check_initial(const Particles<dim>& p, ConstDofView x_fem) const {
   const LO np = static_cast<LO>(p.size());
   Kokkos::View<double*, MemSpace> xp("contact_check_xp", static_cast<std::size_t>(np) * dim);
-  auto px = p.x;
-  Kokkos::parallel_for(
-      "contact_check_xp", Kokkos::RangePolicy<ExecSpace>(0, np), KOKKOS_LAMBDA(const LO q) {
-        for (int c = 0; c < dim; ++c) xp(q * dim + c) = px(q, c);
-      });
+  interleaved_positions(p, xp);
   const LO bad = particle_inside(xp, x_fem);
   if (bad < 0) return;
   auto h = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), p.x);

@@ -48,6 +48,17 @@ Particles<dim> allocate_particles(std::size_t n) {
 
 // All particles of `parts`, in order (part 0 first). Every field is copied,
 // body and material indices unchanged.
+// Node-interleaved copy of the particle positions: xp(q dim + c) = x(q, c)
+// (xp sized np dim by the caller).
+template <int dim>
+void interleaved_positions(const Particles<dim>& p, Kokkos::View<double*, MemSpace> xp) {
+  auto px = p.x;
+  Kokkos::parallel_for(
+      "particle_positions_interleaved", Kokkos::RangePolicy<ExecSpace>(0, p.size()), KOKKOS_LAMBDA(const std::size_t q) {
+        for (int c = 0; c < dim; ++c) xp(q * dim + c) = px(q, c);
+      });
+}
+
 template <int dim>
 Particles<dim> concatenate(const std::vector<Particles<dim>>& parts) {
   std::size_t n = 0;

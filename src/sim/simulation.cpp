@@ -347,11 +347,8 @@ void Simulation<dim>::count_penetrations(StepReport& r) const {
   const auto& p = mpm_->particles();
   const LO np = static_cast<LO>(p.size());
   Kokkos::View<double*, MemSpace> xp("penetration_xp", static_cast<std::size_t>(np) * dim);
+  interleaved_positions(p, xp);
   auto px = p.x;
-  Kokkos::parallel_for(
-      "penetration_xp", Kokkos::RangePolicy<ExecSpace>(0, np), KOKKOS_LAMBDA(const LO q) {
-        for (int c = 0; c < dim; ++c) xp(q * dim + c) = px(q, c);
-      });
   long fem_count = 0;
   if (contact_) fem_count = contact_->count_inside(xp, x_);
   const LevelSetList ls = level_sets_;
@@ -372,7 +369,7 @@ void Simulation<dim>::count_penetrations(StepReport& r) const {
       },
       ls_count, Kokkos::Max<double>(depth));
   r.penetrations = fem_count + ls_count;
-  r.penetration_depth = depth;
+  r.penetration_depth = ls_count > 0 ? depth : 0.0;  // (the Max reducer starts at -DBL_MAX)
 }
 
 // Algorithm 1 lines 5-10: lag friction at x^n, minimise, re-lag at the

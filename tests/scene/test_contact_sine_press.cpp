@@ -234,6 +234,7 @@ TEST(ContactSinePress, LevelSetSlipSinePenetratesAndAdheres) {
     for (int c = 0; c < 3; ++c) ls.seg_velocity[k][c] = vel[k][c];
   }
   setup.level_sets.push_back(ls);
+  setup.count_penetrations = true;  // the diagnostics columns, checked against the count below
   auto sim = std::make_unique<Simulation<2>>(std::move(setup), fixtures::comm());
   const Particles<2>& p = sim->mpm()->particles();
   std::vector<double> y_rest;
@@ -265,6 +266,9 @@ TEST(ContactSinePress, LevelSetSlipSinePenetratesAndAdheres) {
     }
     max_inside[seg] = std::max(max_inside[seg], inside);
     max_depth[seg] = std::max(max_depth[seg], depth);
+    // Output/count penetrations reports the same (no particle is in the ground).
+    EXPECT_EQ(r.penetrations, inside) << "step " << r.step;
+    EXPECT_NEAR(r.penetration_depth, depth, 1e-15) << "step " << r.step;
     if (seg == 2) {
       const double e = particle_kinetic(h) + r.elastic;
       max_energy_rise = std::max(max_energy_rise, e - e_prev);
