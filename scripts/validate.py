@@ -52,9 +52,10 @@ def scenes(size):
         "bands": [],
         "plot": plot_a1,
         "notes": {"ci": ["the energy lost during contact is chaotic at this size: the same APIC run at 2 threads "
-                         "gave 13.9 to 17.2 % in five runs, while FLIP repeats 21.0931 % to every digit (so the "
-                         "APIC path adds in a thread-dependent order somewhere, and the under-resolved barrier "
-                         "amplifies the last bits; tests/scene/test_contact_rings_energy.cpp)"]},
+                         "gave 13.9 to 17.2 % in five runs, while FLIP repeated 21.0931 % to 9 digits: both add "
+                         "contact pairs and the elasticity gradient of the grid's Newmark a^n with atomics, so sums "
+                         "differ in the last bits between runs, and the under-resolved barrier amplifies them, more "
+                         "for APIC than for FLIP here; tests/scene/test_contact_rings_energy.cpp)"]},
     }
     for run, lost in (("A1_apic", 8.57), ("A1_flip", 9.67)):
         s["A1"]["bands"] += [
