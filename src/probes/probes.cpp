@@ -3,9 +3,13 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <limits>
 #include <sstream>
 #include <stdexcept>
+
+#include "io/hdf5_frames.hpp"
 
 namespace bfemp {
 
@@ -238,6 +242,49 @@ double equilibrium_height(const RunTable& t, const std::vector<std::string>& bod
   return M > 0 ? mx / M : kNaN;
 }
 
+double rotation(const std::string& h5, const std::vector<double>& lo, const std::vector<double>& hi,
+                const std::vector<double>& center, int axis, double time) {
+  auto frame = [](int k) {
+    char b[32];
+    std::snprintf(b, sizeof b, "/frame_%06d", k);
+    return std::string(b);
+  };
+  int frames = 0;
+  while (dataset_exists(h5, frame(frames) + "/particle_positions")) ++frames;
+  if (frames == 0) throw std::invalid_argument("probe rotation: no particle frames in '" + h5 + "'");
+  int pick = frames - 1;
+  if (std::isfinite(time)) {
+    double best = kInf;
+    for (int k = 0; k < frames; ++k) {
+      const double d = std::abs(read_attribute(h5, frame(k), "time") - time);
+      if (d < best) best = d, pick = k;
+    }
+  }
+  std::vector<std::size_t> shape;
+  const std::vector<double> x0 = read_dataset(h5, frame(0) + "/particle_positions", &shape);
+  const std::size_t dim = shape.size() > 1 ? shape[1] : 1;
+  const std::vector<double> x1 = read_dataset(h5, frame(pick) + "/particle_positions", nullptr);
+  if (lo.size() != dim || hi.size() != dim || center.size() != dim)
+    throw std::invalid_argument("probe rotation: box_min, box_max and center need " + std::to_string(dim) +
+                                " components (x;y" + std::string(dim == 3 ? ";z" : "") + ")");
+  if (dim == 2 && axis != 2) throw std::invalid_argument("probe rotation: 2D rotates about z only (axis=z)");
+  const int i = (axis + 1) % 3, j = (axis + 2) % 3;  // the plane of the rotation
+  double sum = 0;
+  long n = 0;
+  for (std::size_t q = 0; q < x0.size() / dim; ++q) {
+    bool in = true;
+    for (std::size_t c = 0; c < dim; ++c) in = in && x0[q * dim + c] >= lo[c] && x0[q * dim + c] <= hi[c];
+    if (!in) continue;
+    const double a0 = x0[q * dim + i] - center[i], b0 = x0[q * dim + j] - center[j];
+    const double a1 = x1[q * dim + i] - center[i], b1 = x1[q * dim + j] - center[j];
+    if (a0 * a0 + b0 * b0 < 1e-24) continue;  // on the axis: no angle
+    sum += std::atan2(a0 * b1 - b0 * a1, a0 * a1 + b0 * b1);
+    ++n;
+  }
+  if (n == 0) throw std::invalid_argument("probe rotation: no particle inside [box_min, box_max] off the axis at frame 0");
+  return sum / double(n);
+}
+
 }  // namespace probe
 
 // ---- the registry ------------------------------------------------------------
@@ -333,6 +380,26 @@ const std::vector<ProbeInfo>& probe_list() {
       {"sum", "column=NAME[,from=T0][,to=T1]", "sum of a diagnostics column (e.g. newton_iters, step_s)",
        [](const RunTable& t, const ProbeArgs& a) {
          return column_reduce(t, a, 0.0, [](double s, double v) { return s + v; });
+       }},
+      {"rotation", "box_min=X;Y[;Z],box_max=X;Y[;Z],center=X;Y[;Z][,axis=z][,t=T]",
+       "mean rotation angle about the axis of the particles in the box at frame 0, at the frame nearest t "
+       "(rad; reads the run's bfemp.h5)",
+       [](const RunTable& t, const ProbeArgs& a) {
+         if (t.source_dir().empty())
+           throw std::invalid_argument("probe 'rotation' reads a run's frames: evaluate it on a run directory");
+         auto vec = [&](const std::string& key) {
+           std::vector<double> v;
+           std::stringstream ss(a.text(key));
+           std::string item;
+           while (std::getline(ss, item, ';')) {
+             char* end = nullptr;
+             v.push_back(std::strtod(item.c_str(), &end));
+             if (end == item.c_str() || *end != '\0') bad_arg(a.name, key, a.text(key), "numbers joined by ';'");
+           }
+           return v;
+         };
+         return probe::rotation(t.source_dir() + "/bfemp.h5", vec("box_min"), vec("box_max"), vec("center"),
+                                a.axis("axis", 2), t_of(a));
        }},
       {"value", "column=NAME[,t=T]", "a diagnostics column at t",
        [](const RunTable& t, const ProbeArgs& a) { return t.column(a.text("column"))[probe::row_at(t, t_of(a))]; }},

@@ -30,6 +30,10 @@
 //  equilibrium_height mass-weighted centre-of-mass `axis` of the bodies
 //                     listed in `bodies` (joined by '+') at t (A5)
 //  min, max, sum, value of any diagnostics column over [from, to] (value: at t)
+//  rotation           mean rotation angle (rad) about `axis` through `center`
+//                     of the particles inside [box_min, box_max] at frame 0,
+//                     at the output frame nearest t (read from the run's
+//                     bfemp.h5; vectors are written x;y[;z]); A7's twist
 #include <functional>
 #include <map>
 #include <string>
@@ -82,6 +86,12 @@ double half_width(const RunTable& t, int axis, std::size_t row);
 double fit_slope(const std::vector<double>& x, const std::vector<double>& y);
 double hertz_slope(const RunTable& t, int force_axis, int width_axis, double a_max);
 double equilibrium_height(const RunTable& t, const std::vector<std::string>& bodies, int axis, double time);
+// Mean angle of rotation about the axis (0, 1, 2; 2D: 2 only) through
+// `center` from frame 0 to the frame nearest `time` (NaN: the last), of the
+// particles inside [lo, hi] at frame 0, each angle in (-pi, pi]; `h5` is a
+// run's bfemp.h5. std::invalid_argument when no particle is selected.
+double rotation(const std::string& h5, const std::vector<double>& lo, const std::vector<double>& hi,
+                const std::vector<double>& center, int axis, double time);
 }  // namespace probe
 
 }  // namespace bfemp

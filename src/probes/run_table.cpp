@@ -36,6 +36,7 @@ void RunTable::add_row(const std::vector<double>& row) {
 RunTable RunTable::read_csv(const std::string& path_in) {
   std::string path = path_in;
   if (std::filesystem::is_directory(path)) path += "/diagnostics.csv";
+  const std::string dir = std::filesystem::path(path).parent_path().string();
   std::ifstream in(path);
   if (!in) throw std::invalid_argument("run table: '" + path + "' cannot be read (expected a diagnostics.csv)");
   std::string line;
@@ -79,6 +80,7 @@ RunTable RunTable::read_csv(const std::string& path_in) {
                                   std::to_string(names.size()) + " (one per column)");
     }  // else: a torn last row of a run still writing or killed
   }
+  t.set_source_dir(dir.empty() ? "." : dir);
   return t;
 }
 

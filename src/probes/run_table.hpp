@@ -38,12 +38,17 @@ class RunTable {
   const std::vector<double>& column(const std::string& name) const;
   // The body names of "<body>.com_x" columns, in column order.
   std::vector<std::string> bodies() const;
+  // The run directory the table was read from ("" when recorded in memory):
+  // probes of the frames (bfemp.h5) read there.
+  const std::string& source_dir() const { return dir_; }
+  void set_source_dir(const std::string& dir) { dir_ = dir; }
 
  private:
   std::vector<std::string> names_;
   std::map<std::string, std::size_t> index_;
   std::vector<std::vector<double>> data_;  // per column
   std::size_t rows_ = 0;
+  std::string dir_;
 };
 
 }  // namespace bfemp

@@ -20,6 +20,7 @@
 #include <iterator>
 
 #include "common/fem_fixtures.hpp"
+#include "io/hdf5_frames.hpp"
 #include "io/run_output.hpp"
 #include "io/scene.hpp"
 #include "probes/probes.hpp"
@@ -211,5 +212,65 @@ TEST(Probes, CsvOfARealRunEqualsTheRecordedTableAndTornRowsAreHandled) {
   } catch (const std::invalid_argument& e) {
     EXPECT_NE(std::string(e.what()).find("line 3"), std::string::npos) << e.what();
   }
+  std::filesystem::remove_all(dir);
+}
+
+// The rotation probe on frames with a known rigid rotation: a ring of points
+// (and a point on the axis, skipped) rotated by omega t about z through
+// (0.5, 0.5) in 2D, and about x in 3D; a second group outside the box moves
+// differently and must not count.
+TEST(Probes, RotationOfAPointSetFromTheFrames) {
+  const std::string dir = (std::filesystem::temp_directory_path() / "bfemp_test_probe_rotation").string();
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  const double omega = 0.6283185307179586;  // A7's pi/5 rad/s
+  {
+    Hdf5FrameWriter w(dir + "/bfemp.h5");
+    for (int k = 0; k < 6; ++k) {
+      const double t = 0.5 * k, th = omega * t;
+      std::vector<double> x;
+      for (int q = 0; q < 12; ++q) {
+        const double r = 0.1 + 0.02 * q, a0 = 0.3 * q;
+        x.push_back(0.5 + r * std::cos(a0 + th));
+        x.push_back(0.5 + r * std::sin(a0 + th));
+      }
+      x.push_back(0.5), x.push_back(0.5);                   // on the axis
+      x.push_back(2.0 + 0.1 * k), x.push_back(2.0 - 0.3 * k);  // outside the box
+      w.begin_frame(k, t, 10 * k);
+      w.write_array("particle_positions", x.data(), x.size() / 2, 2);
+      w.end_frame();
+    }
+    w.close();
+  }
+  RunTable t = table_of(3, 0.0, 1.0, [](double, StepReport&) {});
+  t.set_source_dir(dir);
+  const std::string box = "rotation:box_min=0;0,box_max=1;1,center=0.5;0.5";
+  EXPECT_NEAR(evaluate_probe(box, t), omega * 2.5, 1e-12) << "last frame";
+  EXPECT_NEAR(evaluate_probe(box + ",t=1.1", t), omega * 1.0, 1e-12) << "frame nearest 1.1 s: t = 1 s";
+  EXPECT_NEAR(evaluate_probe(box + ",t=0", t), 0.0, 1e-15);
+  EXPECT_NE(error_of("rotation:box_min=0;0,box_max=1;1,center=0.5;0.5,axis=x", t).find("about z"), std::string::npos);
+  EXPECT_NE(error_of("rotation:box_min=5;5,box_max=6;6,center=0.5;0.5", t).find("no particle"), std::string::npos);
+  EXPECT_NE(error_of("rotation:box_min=0;0;0,box_max=1;1,center=0.5;0.5", t).find("2 components"), std::string::npos);
+  EXPECT_NE(error_of("rotation:box_min=0;a,box_max=1;1,center=0.5;0.5", t).find("numbers joined by ';'"),
+            std::string::npos);
+  RunTable mem = table_of(3, 0.0, 1.0, [](double, StepReport&) {});
+  EXPECT_NE(error_of(box, mem).find("run directory"), std::string::npos);
+  // 3D, about x through (0, 1, 1).
+  {
+    Hdf5FrameWriter w(dir + "/bfemp.h5");
+    for (int k = 0; k < 3; ++k) {
+      const double th = -0.4 * k;
+      std::vector<double> x;
+      for (int q = 0; q < 8; ++q) {
+        const double r = 0.2 + 0.05 * q, a0 = 0.7 * q;
+        x.insert(x.end(), {0.1 * q, 1.0 + r * std::cos(a0 + th), 1.0 + r * std::sin(a0 + th)});
+      }
+      w.begin_frame(k, 0.1 * k, k);
+      w.write_array("particle_positions", x.data(), x.size() / 3, 3);
+      w.end_frame();
+    }
+    w.close();
+  }
+  EXPECT_NEAR(evaluate_probe("rotation:box_min=-1;0;0,box_max=1;2;2,center=0;1;1,axis=x", t), -0.8, 1e-12);
   std::filesystem::remove_all(dir);
 }
