@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# bfemp set-up: Debian packages + Trilinos 13.2 with Kokkos' OpenMP backend.
+# bfemp set-up: Debian packages + Trilinos 13.2 with Kokkos' OpenMP backend
+# (the `r2` configuration: + Xpetra, MueLu, Zoltan, Zoltan2 for MPI runs).
 # Idempotent; run as root on Debian bookworm.
 #   scripts/setup.sh [--prefix DIR] [--archive FILE] [--from-source] [--no-apt] [--with-paraview]
 # The prebuilt archive (shared/deps/README.md) is used when --archive or
@@ -28,8 +29,8 @@ while [ $# -gt 0 ]; do
   esac
 done
 
-TRILINOS_PREFIX=$PREFIX_ROOT/trilinos-13.2.0-omp
-default_archive=$here/../shared/deps/trilinos-13.2.0-omp-bookworm-x86_64.tar.xz
+TRILINOS_PREFIX=$PREFIX_ROOT/trilinos-13.2.0-omp-r2
+default_archive=$here/../shared/deps/trilinos-13.2.0-omp-r2-bookworm-x86_64.tar.xz
 if [ -z "$ARCHIVE" ] && [ $FROM_SOURCE -eq 0 ] && [ -f "$default_archive" ]; then
   ARCHIVE=$default_archive
 fi
@@ -60,7 +61,9 @@ fi
 
 have_trilinos() {
   local cfg=$TRILINOS_PREFIX/include/KokkosCore_config.h
-  [ -f "$TRILINOS_PREFIX/lib/cmake/Trilinos/TrilinosConfig.cmake" ] && [ -f "$cfg" ] && grep -q "KOKKOS_ENABLE_OPENMP" "$cfg"
+  [ -f "$TRILINOS_PREFIX/lib/cmake/Trilinos/TrilinosConfig.cmake" ] && [ -f "$cfg" ] && grep -q "KOKKOS_ENABLE_OPENMP" "$cfg" \
+    && [ -f "$TRILINOS_PREFIX/include/MueLu_CreateTpetraPreconditioner.hpp" ] \
+    && [ -f "$TRILINOS_PREFIX/include/Zoltan2_PartitioningProblem.hpp" ]
 }
 
 if have_trilinos; then
@@ -69,9 +72,14 @@ if have_trilinos; then
 fi
 
 if [ -n "$ARCHIVE" ] && [ $FROM_SOURCE -eq 0 ]; then
-  if [ "$TRILINOS_PREFIX" != /opt/bfemp-deps/trilinos-13.2.0-omp ]; then
-    echo "setup: the archive hard-codes /opt/bfemp-deps/trilinos-13.2.0-omp; use --from-source for prefix $PREFIX_ROOT" >&2
+  if [ "$TRILINOS_PREFIX" != /opt/bfemp-deps/trilinos-13.2.0-omp-r2 ]; then
+    echo "setup: the archive hard-codes /opt/bfemp-deps/trilinos-13.2.0-omp-r2; use --from-source for prefix $PREFIX_ROOT" >&2
     exit 2
+  fi
+  if [ -f "$ARCHIVE.sha256" ]; then
+    want=$(cut -d' ' -f1 < "$ARCHIVE.sha256")
+    got=$(sha256sum "$ARCHIVE" | cut -d' ' -f1)
+    [ "$want" = "$got" ] || { echo "setup: $ARCHIVE: sha256 $got, expected $want (from $ARCHIVE.sha256)" >&2; exit 1; }
   fi
   echo "setup: unpacking $ARCHIVE"
   mkdir -p /opt/bfemp-deps
@@ -81,7 +89,7 @@ if [ -n "$ARCHIVE" ] && [ $FROM_SOURCE -eq 0 ]; then
   exit 0
 fi
 
-# Build from Debian's source package (about 30 minutes on 2 cores).
+# Build from Debian's source package (about 70 minutes on 2 cores).
 work=${BFEMP_BUILD_DIR:-/tmp/bfemp-trilinos-build}
 mkdir -p "$work/sources.list.d" "$work/lists/partial"
 cd "$work"
@@ -109,7 +117,11 @@ cmake -S "$src" -B "$work/build" -G Ninja \
   -DTpetra_INST_FLOAT=OFF -DTpetra_INST_COMPLEX_DOUBLE=OFF \
   -DTpetra_INST_INT_INT=OFF -DTpetra_INST_INT_LONG_LONG=ON \
   -DTrilinos_ENABLE_EXPLICIT_INSTANTIATION=ON \
-  -DTrilinos_ENABLE_Xpetra=OFF -DTrilinos_ENABLE_Zoltan2=OFF -DTrilinos_ENABLE_Epetra=OFF \
+  -DTrilinos_ENABLE_Epetra=OFF \
+  -DTrilinos_ENABLE_Xpetra=ON -DTrilinos_ENABLE_MueLu=ON \
+  -DTrilinos_ENABLE_Zoltan=ON -DTrilinos_ENABLE_Zoltan2=ON \
+  -DMueLu_ENABLE_Epetra=OFF -DXpetra_ENABLE_Epetra=OFF \
+  -DXpetra_ENABLE_EpetraExt=OFF -DZoltan2_ENABLE_Epetra=OFF \
   "-DCMAKE_CXX_FLAGS=-O2 -w"
 ninja -C "$work/build" -j"$(nproc)" install
 have_trilinos || { echo "setup: build finished but no OpenMP Trilinos at $TRILINOS_PREFIX" >&2; exit 1; }

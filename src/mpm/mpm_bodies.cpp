@@ -211,6 +211,74 @@ typename MpmBodies<dim>::Diagnostics MpmBodies<dim>::diagnostics(const std::arra
   return d;
 }
 
+namespace {
+
+// Array reduction: kBodyFields sums per body, laid out [body * kBodyFields + f].
+constexpr int kBodyFields = 12;  // ke, el, pe, p0..2, L, M, X0..2, (pad)
+
+template <int dim>
+struct BodyDiagnosticsSum {
+  using value_type = double[];
+  using size_type = std::size_t;
+  size_type value_count;
+  Particles<dim> p;
+  Kokkos::View<const MaterialParams*, MemSpace> mats;
+  std::array<double, 3> g;
+  bool apic;
+  double D;
+
+  KOKKOS_INLINE_FUNCTION void operator()(const LO q, value_type acc) const {
+    double* a = acc + static_cast<std::size_t>(p.body(q)) * kBodyFields;
+    const double m = p.mass(q);
+    Mat<dim> F;
+    for (int i = 0; i < dim; ++i)
+      for (int j = 0; j < dim; ++j) F(i, j) = p.F(q, i, j);
+    a[1] += p.volume0(q) * material_energy<dim>(mats(p.material(q)), F);
+    double v2 = 0;
+    for (int c = 0; c < dim; ++c) {
+      v2 += p.v(q, c) * p.v(q, c);
+      a[2] -= m * g[c] * p.x(q, c);
+      a[3 + c] += m * p.v(q, c);
+      a[9 + c] += m * p.x(q, c);
+    }
+    a[0] += 0.5 * m * v2;
+    a[6] += m * (p.x(q, 0) * p.v(q, 1) - p.x(q, 1) * p.v(q, 0));
+    if (apic) a[6] += m * D * (p.C(q, 1, 0) - p.C(q, 0, 1));
+    a[8] += m;
+  }
+  KOKKOS_INLINE_FUNCTION void join(volatile value_type dst, const volatile value_type src) const {
+    for (size_type i = 0; i < value_count; ++i) dst[i] += src[i];
+  }
+  KOKKOS_INLINE_FUNCTION void init(value_type v) const {
+    for (size_type i = 0; i < value_count; ++i) v[i] = 0.0;
+  }
+};
+
+}  // namespace
+
+template <int dim>
+std::vector<typename MpmBodies<dim>::Diagnostics> MpmBodies<dim>::body_diagnostics(
+    const std::array<double, 3>& g) const {
+  const std::size_t nb = std::max<std::size_t>(1, setup_.body_names.size());
+  BodyDiagnosticsSum<dim> f{nb * kBodyFields, setup_.particles, materials_, g,
+                            setup_.scheme == TransferScheme::APIC, setup_.grid.dx * setup_.grid.dx / 4.0};
+  std::vector<double> sums(nb * kBodyFields, 0.0);
+  Kokkos::parallel_reduce("mpm_body_diagnostics", Kokkos::RangePolicy<ExecSpace>(0, setup_.particles.size()), f,
+                          sums.data());
+  std::vector<Diagnostics> out(nb);  // (one entry for an unnamed set of particles)
+  for (std::size_t b = 0; b < out.size(); ++b) {
+    const double* a = sums.data() + b * kBodyFields;
+    Diagnostics& d = out[b];
+    d.kinetic = a[0];
+    d.elastic = a[1];
+    d.potential = a[2];
+    for (int c = 0; c < 3; ++c) d.momentum[c] = a[3 + c], d.first_moment[c] = a[9 + c];
+    d.angular = a[6];
+    d.mass = a[8];
+  }
+  return out;
+}
+
 template class MpmElasticityTerm<2>;
 template class MpmElasticityTerm<3>;
 template class MpmBodies<2>;

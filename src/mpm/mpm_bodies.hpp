@@ -95,6 +95,9 @@ class MpmBodies {
     double mass = 0, first_moment[3] = {0, 0, 0};
   };
   Diagnostics diagnostics(const std::array<double, 3>& gravity, int body = -1) const;
+  // Every body's Diagnostics in one pass over the particles (index = body);
+  // their sum is diagnostics(gravity) up to summation order.
+  std::vector<Diagnostics> body_diagnostics(const std::array<double, 3>& gravity) const;
   const std::vector<std::string>& body_names() const { return setup_.body_names; }
 
  private:

@@ -343,10 +343,12 @@ StepReport Simulation<dim>::step() {
 }
 
 template <int dim>
-void Simulation<dim>::count_penetrations(StepReport& r) const {
+void Simulation<dim>::count_penetrations(StepReport& r) {
   const auto& p = mpm_->particles();
   const LO np = static_cast<LO>(p.size());
-  Kokkos::View<double*, MemSpace> xp("penetration_xp", static_cast<std::size_t>(np) * dim);
+  if (penetration_xp_.extent(0) != static_cast<std::size_t>(np) * dim)
+    penetration_xp_ = Kokkos::View<double*, MemSpace>("penetration_xp", static_cast<std::size_t>(np) * dim);
+  const auto xp = penetration_xp_;
   interleaved_positions(p, xp);
   auto px = p.x;
   long fem_count = 0;
@@ -431,7 +433,12 @@ StepReport Simulation<dim>::diagnostics() const {
   r.kinetic = ke;
   r.potential = pe;
   r.momentum = {p0, p1, p2};
-  r.elastic = deformation_energy(mesh_.elements, x_);
+  // FEM elastic energy: the sum of the bodies' (computed below) when the
+  // bodies cover every element, else one pass over the whole mesh.
+  LO body_cells = 0;
+  for (const auto& b : mesh_.bodies) body_cells += b.num_cells;
+  const bool bodies_cover = body_cells == mesh_.num_cells();
+  r.elastic = bodies_cover ? 0.0 : deformation_energy(mesh_.elements, x_);
   r.min_J = mesh_.num_cells() > 0 ? deformation_min_J(mesh_.elements, x_) : 1.0;
   {
     auto X = x_;
@@ -444,13 +451,18 @@ StepReport Simulation<dim>::diagnostics() const {
         L);
     r.angular_momentum_z = L;
   }
+  // MPM: every body's sums in one pass over the particles; the totals are
+  // their sum.
+  std::vector<typename MpmBodies<dim>::Diagnostics> mpm_bodies;
   if (mpm_) {
-    const auto d = mpm_->diagnostics(setup_.gravity);
-    r.kinetic += d.kinetic;
-    r.elastic += d.elastic;
-    r.potential += d.potential;
-    for (int c = 0; c < 3; ++c) r.momentum[c] += d.momentum[c];
-    r.angular_momentum_z += d.angular;
+    mpm_bodies = mpm_->body_diagnostics(setup_.gravity);
+    for (const auto& d : mpm_bodies) {
+      r.kinetic += d.kinetic;
+      r.elastic += d.elastic;
+      r.potential += d.potential;
+      for (int c = 0; c < 3; ++c) r.momentum[c] += d.momentum[c];
+      r.angular_momentum_z += d.angular;
+    }
     r.min_J = std::min(r.min_J, mpm_particle_min_J(mpm_->particles()));
     r.active_grid_nodes = mpm_->active_nodes();
   }
@@ -474,6 +486,7 @@ StepReport Simulation<dim>::diagnostics() const {
     br.mass = M;
     br.kinetic = k;
     br.elastic = deformation_energy(mesh_.elements, x_, b.first_cell, b.first_cell + b.num_cells);
+    if (bodies_cover) r.elastic += br.elastic;
     for (int c = 0; c < dim; ++c) {
       br.com[c] = M > 0 ? X[c] / M : 0.0;
       br.velocity[c] = M > 0 ? P[c] / M : 0.0;
@@ -482,7 +495,7 @@ StepReport Simulation<dim>::diagnostics() const {
   }
   if (mpm_) {
     for (std::size_t b = 0; b < mpm_->body_names().size(); ++b) {
-      const auto d = mpm_->diagnostics(setup_.gravity, static_cast<int>(b));
+      const auto& d = mpm_bodies[b];
       BodyReport br;
       br.mass = d.mass;
       br.kinetic = d.kinetic;

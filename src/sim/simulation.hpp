@@ -134,7 +134,7 @@ class Simulation {
   struct System;
   void apply_prescribed_targets(double t, Kokkos::View<double*, MemSpace> target) const;
   void prescribed_velocities(double t1);
-  void count_penetrations(StepReport& r) const;
+  void count_penetrations(StepReport& r);
   NewtonStats minimize_with_friction(const IncrementalPotential& ip, Kokkos::View<double*, MemSpace> x,
                                      Kokkos::View<double*, MemSpace> x_ref, double s, int& iterations);
 
@@ -148,6 +148,7 @@ class Simulation {
   LevelSetList level_sets_;
   Kokkos::View<double*, MemSpace> x_, v_, a_, mass_, initial_position_;
   Kokkos::View<int*, MemSpace> prescribed_;
+  Kokkos::View<double*, MemSpace> penetration_xp_;  // count_penetrations: particle positions, kept
   DeviceMotions motions_;  // prescribed nodes and their segments, on the device
   double time_ = 0;
   long step_ = 0;

@@ -8,7 +8,9 @@ namespace bfemp {
 
 template <int dim>
 Teuchos::RCP<const Graph> build_dof_graph(std::vector<long long>& keys, LO n_nodes,
-                                          const Teuchos::RCP<const Map>& dof_map) {
+                                          const Teuchos::RCP<const Map>& dof_map,
+                                          Teuchos::RCP<const Map> domain_range) {
+  if (domain_range.is_null()) domain_range = dof_map;
   for (LO i = 0; i < n_nodes; ++i) keys.push_back(static_cast<long long>(i) * n_nodes + i);
   std::sort(keys.begin(), keys.end());
   keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
@@ -35,11 +37,13 @@ Teuchos::RCP<const Graph> build_dof_graph(std::vector<long long>& keys, LO n_nod
   Kokkos::deep_copy(rowptr, rp);
   Kokkos::deep_copy(colind, ci);
   auto graph = Teuchos::rcp(new Graph(dof_map, dof_map, rowptr, colind));
-  graph->fillComplete(dof_map, dof_map);
+  graph->fillComplete(domain_range, domain_range);
   return graph;
 }
 
-template Teuchos::RCP<const Graph> build_dof_graph<2>(std::vector<long long>&, LO, const Teuchos::RCP<const Map>&);
-template Teuchos::RCP<const Graph> build_dof_graph<3>(std::vector<long long>&, LO, const Teuchos::RCP<const Map>&);
+template Teuchos::RCP<const Graph> build_dof_graph<2>(std::vector<long long>&, LO, const Teuchos::RCP<const Map>&,
+                                                      Teuchos::RCP<const Map>);
+template Teuchos::RCP<const Graph> build_dof_graph<3>(std::vector<long long>&, LO, const Teuchos::RCP<const Map>&,
+                                                      Teuchos::RCP<const Map>);
 
 }  // namespace bfemp

@@ -10,9 +10,12 @@ namespace bfemp {
 
 // `keys` holds a * n_nodes + b for coupled nodes (any order, duplicates
 // allowed; consumed: sorted and deduplicated in place). Every node couples
-// with itself. 1 rank: column map == row map, local ids == DOF ids.
+// with itself. Column map == row map == dof_map: local column ids are the
+// local DOF ids. `domain_range` (default dof_map) is the one-to-one map the
+// graph is completed with: an overlap (ghosted) dof_map needs the owned one.
 template <int dim>
 Teuchos::RCP<const Graph> build_dof_graph(std::vector<long long>& keys, LO n_nodes,
-                                          const Teuchos::RCP<const Map>& dof_map);
+                                          const Teuchos::RCP<const Map>& dof_map,
+                                          Teuchos::RCP<const Map> domain_range = Teuchos::null);
 
 }  // namespace bfemp

@@ -1,7 +1,12 @@
 #include "solver/dof_space.hpp"
 
 #include <Kokkos_Timer.hpp>
+#include <Teuchos_CommHelpers.hpp>
 #include <Tpetra_CrsMatrix.hpp>
+#include <Tpetra_Export.hpp>
+#include <Tpetra_Import.hpp>
+#include <Tpetra_Vector.hpp>
+#include <stdexcept>
 
 #include "solver/dof_graph.hpp"
 
@@ -14,18 +19,52 @@ DofSpace<dim>::DofSpace(const Teuchos::RCP<const Comm>& comm) : comm_(comm), dro
 }
 
 template <int dim>
+void DofSpace<dim>::set_partition(std::vector<GO> global_nodes, LO n_owned) {
+  if (n_owned < 0 || n_owned > static_cast<LO>(global_nodes.size()))
+    throw std::invalid_argument("DofSpace::set_partition: n_owned outside [0, local nodes]");
+  global_nodes_ = std::move(global_nodes);
+  n_owned_ = n_owned;
+  maps_stale_ = true;
+}
+
+template <int dim>
+void DofSpace<dim>::build_maps() {
+  using gsize = Tpetra::global_size_t;
+  const gsize invalid = Teuchos::OrdinalTraits<gsize>::invalid();
+  std::vector<GO> owned(static_cast<std::size_t>(n_owned_) * dim), all(global_nodes_.size() * dim);
+  for (std::size_t a = 0; a < global_nodes_.size(); ++a)
+    for (int c = 0; c < dim; ++c) {
+      all[a * dim + c] = global_nodes_[a] * dim + c;
+      if (a < static_cast<std::size_t>(n_owned_)) owned[a * dim + c] = global_nodes_[a] * dim + c;
+    }
+  map_ = Teuchos::rcp(new Map(invalid, Teuchos::ArrayView<const GO>(owned), 0, comm_));
+  overlap_map_ = Teuchos::rcp(new Map(invalid, Teuchos::ArrayView<const GO>(all), 0, comm_));
+  export_ = Teuchos::rcp(new Tpetra::Export<LO, GO, Node>(overlap_map_, map_));
+  import_ = Teuchos::rcp(new Tpetra::Import<LO, GO, Node>(map_, overlap_map_));
+  rhs_overlap_ = Teuchos::rcp(new Vector(overlap_map_));
+  x_overlap_ = Teuchos::rcp(new Vector(overlap_map_));
+  maps_stale_ = false;
+}
+
+template <int dim>
 bool DofSpace<dim>::set_structure(LO n_nodes, const std::vector<const EnergyTerm<dim>*>& terms) {
   std::vector<std::uint64_t> versions;
   versions.reserve(terms.size());
   for (const auto* t : terms) versions.push_back(t->couplings_version());
-  const bool same = !A_.is_null() && n_nodes == n_nodes_ && terms == terms_ && versions == versions_;
+  if (distributed() && n_nodes != static_cast<LO>(global_nodes_.size()))
+    throw std::invalid_argument("DofSpace::set_structure: " + std::to_string(n_nodes) +
+                                " nodes, but the partition has " + std::to_string(global_nodes_.size()));
+  const bool same = !A_.is_null() && !maps_stale_ && n_nodes == n_nodes_ && terms == terms_ && versions == versions_;
   terms_ = terms;
   versions_ = std::move(versions);
   if (same) {
     ++graph_reuses_;
     return false;
   }
-  if (n_nodes != n_nodes_) {
+  if (distributed()) {
+    n_nodes_ = n_nodes;
+    if (maps_stale_ || map_.is_null()) build_maps();
+  } else if (n_nodes != n_nodes_) {
     map_ = Teuchos::rcp(new Map(static_cast<Tpetra::global_size_t>(n_nodes) * dim, 0, comm_));
     n_nodes_ = n_nodes;
   }
@@ -38,8 +77,39 @@ void DofSpace<dim>::rebuild() {
   Kokkos::Timer timer;
   std::vector<long long> keys;
   for (const auto* t : terms_) t->add_couplings(keys, n_nodes_);
-  A_ = Teuchos::rcp(new Matrix(build_dof_graph<dim>(keys, n_nodes_, map_)));
-  A_->fillComplete();
+  if (!distributed()) {
+    A_ = Teuchos::rcp(new Matrix(build_dof_graph<dim>(keys, n_nodes_, map_)));
+    A_->fillComplete();
+  } else {
+    if (slip_.count() > 0) throw std::invalid_argument("slip constraints run on 1 MPI rank only in this version");
+    // Overlap graph (local ids), then the owned graph: each owned row holds the
+    // union of its rows on all ranks (row lengths summed first: an upper bound).
+    auto G_ov = build_dof_graph<dim>(keys, n_nodes_, overlap_map_, map_);
+    Vector len_ov(overlap_map_), len(map_);
+    {
+      auto v = len_ov.getLocalViewHost(Tpetra::Access::OverwriteAll);
+      for (LO i = 0; i < static_cast<LO>(v.extent(0)); ++i) v(i, 0) = static_cast<double>(G_ov->getNumEntriesInLocalRow(i));
+    }
+    len.doExport(len_ov, *export_, Tpetra::ADD);
+    std::vector<std::size_t> cap(map_->getNodeNumElements());
+    {
+      auto v = len.getLocalViewHost(Tpetra::Access::ReadOnly);
+      for (std::size_t i = 0; i < cap.size(); ++i) cap[i] = static_cast<std::size_t>(v(i, 0) + 0.5);
+    }
+    auto G = Teuchos::rcp(new Graph(map_, Teuchos::ArrayView<const std::size_t>(cap)));
+    G->doExport(*G_ov, *export_, Tpetra::INSERT);
+    G->fillComplete(map_, map_);
+    A_overlap_ = Teuchos::rcp(new Matrix(G_ov));
+    A_overlap_->fillComplete(map_, map_);
+    A_ = Teuchos::rcp(new Matrix(Teuchos::RCP<const Graph>(G)));
+    A_->fillComplete(map_, map_);
+    const LO n_own = static_cast<LO>(map_->getNodeNumElements());
+    diag_col_ = Kokkos::View<LO*, MemSpace>("dof_diag_col", n_own);
+    auto dh = Kokkos::create_mirror_view(diag_col_);
+    const auto col = A_->getColMap();
+    for (LO i = 0; i < n_own; ++i) dh(i) = col->getLocalElement(map_->getGlobalElement(i));
+    Kokkos::deep_copy(diag_col_, dh);
+  }
   versions_.clear();
   for (const auto* t : terms_) versions_.push_back(t->couplings_version());
   ++graph_builds_;
@@ -49,14 +119,16 @@ void DofSpace<dim>::rebuild() {
 template <int dim>
 void DofSpace<dim>::begin_assembly() {
   Kokkos::deep_copy(dropped_, 0);
-  A_->resumeFill();
-  A_->setAllToScalar(0.0);
+  Matrix& A = distributed() ? *A_overlap_ : *A_;
+  A.resumeFill();
+  A.setAllToScalar(0.0);
 }
 
 template <int dim>
 Sink<dim> DofSpace<dim>::sink(double scale, DofView grad, DofView rhs, MaskView prescribed,
                               ConstDofView dx_prescribed) const {
-  Sink<dim> s = make_sink<dim>(A_->getLocalMatrixDevice(), scale, grad, rhs, prescribed, dx_prescribed);
+  const Matrix& A = distributed() ? *A_overlap_ : *A_;
+  Sink<dim> s = make_sink<dim>(A.getLocalMatrixDevice(), scale, grad, rhs, prescribed, dx_prescribed);
   s.dropped = dropped_;
   return s;
 }
@@ -65,21 +137,67 @@ template <int dim>
 int DofSpace<dim>::dropped_blocks() const {
   int n = 0;
   Kokkos::deep_copy(n, dropped_);
+  if (distributed()) {
+    int g = 0;
+    Teuchos::reduceAll(*comm_, Teuchos::REDUCE_MAX, n, Teuchos::outArg(g));
+    n = g;
+  }
   return n;
 }
 
 template <int dim>
-void DofSpace<dim>::end_assembly(MaskView prescribed, ConstDofView dx_prescribed, DofView rhs) {
+void DofSpace<dim>::end_assembly(MaskView prescribed, ConstDofView dx_prescribed, DofView rhs, Vector& b) {
+  if (!distributed()) {
+    auto lcl = A_->getLocalMatrixDevice();
+    Kokkos::parallel_for(
+        "dof_space_prescribed_rows", Kokkos::RangePolicy<ExecSpace>(0, num_dofs()), KOKKOS_LAMBDA(const LO i) {
+          if (!prescribed(i)) return;
+          const double one = 1.0;
+          lcl.replaceValues(i, &i, 1, &one, false, false);
+          rhs(i) = dx_prescribed(i);
+        });
+    slip_.transform_system(lcl, rhs);
+    A_->fillComplete(fill_params_);
+    auto bv = Kokkos::subview(b.getLocalViewDevice(Tpetra::Access::OverwriteAll), Kokkos::ALL(), 0);
+    Kokkos::deep_copy(bv, rhs);
+    return;
+  }
+  // Sum the overlap matrix and rhs into the owned ones.
+  A_overlap_->fillComplete(map_, map_, fill_params_);
+  {
+    auto rv = Kokkos::subview(rhs_overlap_->getLocalViewDevice(Tpetra::Access::OverwriteAll), Kokkos::ALL(), 0);
+    Kokkos::deep_copy(rv, rhs);
+  }
+  b.putScalar(0.0);
+  b.doExport(*rhs_overlap_, *export_, Tpetra::ADD);
+  A_->resumeFill();
+  A_->setAllToScalar(0.0);
+  A_->doExport(*A_overlap_, *export_, Tpetra::ADD);
+  // Constraint rows on the owned side (owned local DOFs come first locally).
   auto lcl = A_->getLocalMatrixDevice();
+  auto bv = Kokkos::subview(b.getLocalViewDevice(Tpetra::Access::ReadWrite), Kokkos::ALL(), 0);
+  const auto dcol = diag_col_;
   Kokkos::parallel_for(
-      "dof_space_prescribed_rows", Kokkos::RangePolicy<ExecSpace>(0, num_dofs()), KOKKOS_LAMBDA(const LO i) {
+      "dof_space_prescribed_rows_owned", Kokkos::RangePolicy<ExecSpace>(0, num_owned_dofs()), KOKKOS_LAMBDA(const LO i) {
         if (!prescribed(i)) return;
         const double one = 1.0;
-        lcl.replaceValues(i, &i, 1, &one, false, false);
-        rhs(i) = dx_prescribed(i);
+        const LO c = dcol(i);
+        lcl.replaceValues(i, &c, 1, &one, false, false);
+        bv(i) = dx_prescribed(i);
       });
-  slip_.transform_system(lcl, rhs);
-  A_->fillComplete(fill_params_);
+  A_->fillComplete(map_, map_, fill_params_);
+}
+
+template <int dim>
+void DofSpace<dim>::to_local(const Vector& owned, DofView local) {
+  if (!distributed()) {
+    auto v = Kokkos::subview(owned.getLocalViewDevice(Tpetra::Access::ReadOnly), Kokkos::ALL(), 0);
+    Kokkos::deep_copy(local, v);
+    return;
+  }
+  x_overlap_->doImport(owned, *import_, Tpetra::INSERT);
+  auto v = Kokkos::subview(x_overlap_->getLocalViewDevice(Tpetra::Access::ReadOnly), Kokkos::ALL(), 0);
+  Kokkos::deep_copy(local, v);
 }
 
 template class DofSpace<2>;

@@ -13,9 +13,18 @@
 //     and slip constraints on grid nodes (SlipConstraints), applied here only;
 //   - the sink through which every term adds its local (nodes, gradient,
 //     Hessian).
-// One rank: local ids == DOF ids. The MPI issue gives this object owned and
-// overlap maps; everything that depends on the numbering is behind it.
+// One rank (no partition): local ids == DOF ids.
+// Distributed (set_partition): the local nodes are this rank's owned nodes
+// (first) and its ghosts, each with a global node id. Every local View (x,
+// gradient, rhs, direction) covers all local nodes; the terms assemble into
+// an overlap matrix (rows and columns: all local DOFs, local column ids ==
+// local DOF ids, so the sink is the same) and one Export with ADD moves the
+// sums into the owned matrix and right-hand side the linear solver sees; the
+// solution comes back to the ghosts with one Import. Constraint rows are
+// written once, on the owned side. Slip constraints: 1 rank only (for now).
 #include <Teuchos_ParameterList.hpp>
+#include <Tpetra_Export_decl.hpp>
+#include <Tpetra_Import_decl.hpp>
 #include <cstdint>
 #include <vector>
 
@@ -30,6 +39,16 @@ class DofSpace {
  public:
   explicit DofSpace(const Teuchos::RCP<const Comm>& comm);
 
+  // Distributed numbering: local node a (0 <= a < global_nodes.size()) is
+  // global node global_nodes[a]; the first n_owned are owned here, each global
+  // node is owned by exactly one rank. Takes effect at the next
+  // set_structure (whose n_nodes must be global_nodes.size()).
+  void set_partition(std::vector<GO> global_nodes, LO n_owned);
+  bool distributed() const { return n_owned_ >= 0; }
+  // Owned nodes and DOFs of this rank (all nodes without a partition).
+  LO num_owned_nodes() const { return n_owned_ >= 0 ? n_owned_ : n_nodes_; }
+  std::size_t num_owned_dofs() const { return static_cast<std::size_t>(num_owned_nodes() < 0 ? 0 : num_owned_nodes()) * dim; }
+
   // Declares the nodes and the terms. Returns true when the map or graph was
   // rebuilt (the matrix is new: its linear solver must be told), false when
   // the cached graph serves (same node count, same terms, same coupling
@@ -41,7 +60,10 @@ class DofSpace {
 
   LO num_nodes() const { return n_nodes_; }
   std::size_t num_dofs() const { return static_cast<std::size_t>(n_nodes_ < 0 ? 0 : n_nodes_) * dim; }
+  // The linear system's (owned, one-to-one) DOF map and matrix; the overlap
+  // map of all local DOFs (== map() without a partition).
   Teuchos::RCP<const Map> map() const { return map_; }
+  Teuchos::RCP<const Map> overlap_map() const { return overlap_map_.is_null() ? map_ : overlap_map_; }
   Teuchos::RCP<Matrix> matrix() const { return A_; }
   const std::vector<const EnergyTerm<dim>*>& terms() const { return terms_; }
 
@@ -51,15 +73,20 @@ class DofSpace {
   // Constraint rows: A(i, i) = 1 and rhs(i) = dxp(i) at prescribed DOFs (the
   // caller has added the free rows' own diagonal), then the slip transform
   // A <- P A P + Q, rhs <- P (rhs - A w) + w on slip nodes; fillComplete.
-  void end_assembly(MaskView prescribed, ConstDofView dx_prescribed, DofView rhs);
+  // Then copies (1 rank) or exports with ADD (distributed) rhs into b (on
+  // map()); distributed: the owned matrix is the sum of all ranks' overlap
+  // matrices, then its constraint rows are written.
+  void end_assembly(MaskView prescribed, ConstDofView dx_prescribed, DofView rhs, Vector& b);
+  // The owned vector's values at every local DOF (owned and ghost).
+  void to_local(const Vector& owned, DofView local);
 
   SlipConstraints<dim>& slip() { return slip_; }
   const SlipConstraints<dim>& slip() const { return slip_; }
 
   // Counters since construction, and the time of the last rebuild.
   long graph_builds() const { return graph_builds_; }
-  // Blocks the last assembly found missing from the graph (0 when the cached
-  // graph held every coupling), and how often that forced a rebuild.
+  // Blocks the last assembly found missing from the graph on any rank (0 when
+  // the cached graph held every coupling), and how often that forced a rebuild.
   int dropped_blocks() const;
   long missing_block_rebuilds() const { return missing_rebuilds_; }
   void count_missing_block_rebuild() { ++missing_rebuilds_; }
@@ -70,8 +97,16 @@ class DofSpace {
   Teuchos::RCP<const Comm> comm_;
   Teuchos::RCP<Teuchos::ParameterList> fill_params_;
   LO n_nodes_ = -1;
-  Teuchos::RCP<const Map> map_;
-  Teuchos::RCP<Matrix> A_;
+  std::vector<GO> global_nodes_;  // distributed: global id of each local node
+  LO n_owned_ = -1;               // distributed: owned nodes (the first ones)
+  bool maps_stale_ = false;
+  Teuchos::RCP<const Map> map_, overlap_map_;
+  Teuchos::RCP<Matrix> A_, A_overlap_;  // A_overlap_: the terms' sink (distributed)
+  Teuchos::RCP<const Tpetra::Export<LO, GO, Node>> export_;
+  Teuchos::RCP<const Tpetra::Import<LO, GO, Node>> import_;
+  Teuchos::RCP<Vector> rhs_overlap_, x_overlap_;
+  Kokkos::View<LO*, MemSpace> diag_col_;  // distributed: column id of each owned row's diagonal
+  void build_maps();
   std::vector<const EnergyTerm<dim>*> terms_;
   std::vector<std::uint64_t> versions_;
   SlipConstraints<dim> slip_;

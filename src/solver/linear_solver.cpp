@@ -12,6 +12,7 @@
 #include <sstream>
 
 #include "solver/cholmod_direct.hpp"
+#include "solver/muelu_preconditioner.hpp"
 #include "solver/solver_error.hpp"
 
 namespace bfemp {
@@ -21,7 +22,7 @@ using Teuchos::ParameterList;
 using Teuchos::RCP;
 using Teuchos::rcp;
 
-const char* const kPrecNames[] = {"RELAXATION", "CHEBYSHEV", "RILUK", "SCHWARZ", "NONE"};
+const char* const kPrecNames[] = {"RELAXATION", "CHEBYSHEV", "RILUK", "SCHWARZ", "MUELU", "NONE"};
 
 // Ifpack2 validates only RELAXATION's list; the others ignore unknown keys, so
 // bfemp checks those against the keys each one reads (Ifpack2 13.2 sources).
@@ -66,9 +67,11 @@ void check_ifpack2_keys(const std::string& prec, const ParameterList& list) {
 Teuchos::RCP<const Teuchos::ParameterList> linear_solver_schema() {
   auto pl = rcp(new ParameterList("Linear Solver"));
   Teuchos::setStringToIntegralParameter<int>(
-      "type", "Cholmod", "Cholmod or KLU2 (direct, 1 MPI rank only) or CG (Belos + Ifpack2)",
+      "type", "Cholmod",
+      "Cholmod or KLU2 (direct, 1 MPI rank only) or CG (Belos + Ifpack2 or MueLu)",
       Teuchos::tuple<std::string>("Cholmod", "KLU2", "CG"), pl.get());
-  auto& cg = pl->sublist("CG", false, "Belos conjugate gradients with an Ifpack2 preconditioner");
+  auto& cg = pl->sublist("CG", false,
+                         "Belos conjugate gradients with an Ifpack2 or MueLu preconditioner");
   cg.set("tolerance", 1e-12,
          "relative residual |b - A x| / |b| at which CG stops (with 'forcing term: adaptive', the "
          "tightest it is asked for)",
@@ -81,13 +84,23 @@ Teuchos::RCP<const Teuchos::ParameterList> linear_solver_schema() {
   cg.set("max iterations", 2000, "CG iteration cap; reaching it is an error",
          rcp(new Teuchos::EnhancedNumberValidator<int>(1, 1000000)));
   Teuchos::setStringToIntegralParameter<int>(
-      "preconditioner", "RELAXATION", "Ifpack2 preconditioner",
+      "preconditioner", "RELAXATION",
+      "Ifpack2 preconditioner (RELAXATION, CHEBYSHEV, RILUK, SCHWARZ), MUELU (algebraic "
+      "multigrid, smoothed aggregation with the rigid-body modes of the nodes as near-null "
+      "space) or NONE",
       Teuchos::tuple<std::string>(kPrecNames[0], kPrecNames[1], kPrecNames[2], kPrecNames[3],
-                                  kPrecNames[4]),
+                                  kPrecNames[4], kPrecNames[5]),
       &cg);
   auto& ifp = cg.sublist("Ifpack2", false,
                          "parameters passed to the Ifpack2 preconditioner (checked by bfemp)");
   ifp.disableRecursiveValidation();
+  auto& mu = cg.sublist("MueLu", false,
+                        "parameters passed to MueLu (checked by MueLu before the first step); "
+                        "bfemp's defaults: 'verbosity' none, 'multigrid algorithm' sa, "
+                        "'reuse: type' none; on > 1 rank 'coarse: type' RELAXATION (4 "
+                        "symmetric Gauss-Seidel sweeps: KLU2, MueLu's default, is wrong on several "
+                        "ranks in Trilinos 13.2)");
+  mu.disableRecursiveValidation();
   return pl;
 }
 
@@ -115,6 +128,7 @@ struct LinearSolver::Impl {
   std::unique_ptr<CholmodDirect> cholmod;  // Cholmod: SuiteSparse directly
   bool symbolic_done = false;
   RCP<Prec> prec;
+  std::unique_ptr<MueLuPreconditioner> muelu;
   std::string prec_name;
   ParameterList ifpack2;
   double cg_tol = 1e-12;
@@ -142,7 +156,21 @@ LinearSolver::LinearSolver(const ParameterList& params, const RCP<const Comm>& c
   impl_->ifpack2 = cg.sublist("Ifpack2");
   if (impl_->prec_name == "SCHWARZ" && !impl_->ifpack2.isParameter("schwarz: combine mode"))
     impl_->ifpack2.set("schwarz: combine mode", "ADD");  // 13.2 default (ZERO) is non-symmetric
-  if (kind_ == LinearSolverKind::CG) check_ifpack2_keys(impl_->prec_name, impl_->ifpack2);
+  if (kind_ == LinearSolverKind::CG && impl_->prec_name == "MUELU")
+    impl_->muelu = std::make_unique<MueLuPreconditioner>(cg.sublist("MueLu"), comm);
+  else if (kind_ == LinearSolverKind::CG)
+    check_ifpack2_keys(impl_->prec_name, impl_->ifpack2);
+}
+
+bool LinearSolver::wants_near_null_space() const { return impl_->muelu != nullptr; }
+
+void LinearSolver::set_near_null_space(const RCP<MultiVec>& modes, int block_size) {
+  if (impl_->muelu) impl_->muelu->set_near_null_space(modes, block_size);
+}
+
+int LinearSolver::preconditioner_setups() const {
+  if (impl_->muelu) return impl_->muelu->setups();
+  return 0;
 }
 
 LinearSolver::~LinearSolver() = default;
@@ -156,7 +184,9 @@ std::string LinearSolver::describe() const {
   if (kind_ != LinearSolverKind::CG) return std::string("Amesos2 ") + linear_solver_name(kind_);
   std::ostringstream s;
   s << "Belos CG (tol " << impl_->cg_tol << (impl_->adaptive ? ", adaptive forcing term" : "") << ", max "
-    << impl_->cg_max_iters << ") + Ifpack2 " << impl_->prec_name;
+    << impl_->cg_max_iters << ") + "
+    << (impl_->muelu ? std::string("MueLu (smoothed aggregation, rigid-body near-null space)")
+                     : "Ifpack2 " + impl_->prec_name);
   return s.str();
 }
 
@@ -165,7 +195,9 @@ void LinearSolver::set_matrix(const RCP<const Matrix>& A) {
   m.A = A;
   if (kind_ == LinearSolverKind::CG) {
     m.prec = Teuchos::null;
-    if (m.prec_name != "NONE") {
+    if (m.muelu) {
+      m.muelu->set_matrix(A);
+    } else if (m.prec_name != "NONE") {
       m.prec = Ifpack2::Factory::create<Tpetra::RowMatrix<double, LO, GO, Node>>(m.prec_name, A);
       try {
         m.prec->setParameters(m.ifpack2);
@@ -230,7 +262,18 @@ LinearSolveStats LinearSolver::solve(const Vector& b, Vector& x, double forcing)
                         std::to_string(stats.achieved_tol));
     return stats;
   }
-  if (!m.prec.is_null()) m.prec->compute();
+  RCP<Operator> M;
+  if (m.muelu) {
+    try {
+      m.muelu->compute();
+    } catch (const std::exception& e) {
+      throw SolverError(std::string("MueLu set-up failed: ") + e.what());
+    }
+    M = m.muelu->op();
+  } else if (!m.prec.is_null()) {
+    m.prec->compute();
+    M = m.prec;
+  }
   const double tol = m.adaptive && forcing > 0 ? std::max(m.cg_tol, std::min(0.1, forcing)) : m.cg_tol;
   stats.tolerance = tol;
   auto bp = Teuchos::parameterList();
@@ -242,7 +285,7 @@ LinearSolveStats LinearSolver::solve(const Vector& b, Vector& x, double forcing)
   auto xp = Teuchos::rcpFromRef(static_cast<MultiVec&>(x));
   auto bpv = Teuchos::rcpFromRef(static_cast<const MultiVec&>(b));
   auto problem = rcp(new Belos::LinearProblem<double, MultiVec, Operator>(m.A, xp, bpv));
-  if (!m.prec.is_null()) problem->setLeftPrec(m.prec);
+  if (!M.is_null()) problem->setLeftPrec(M);
   problem->setProblem();
   Belos::PseudoBlockCGSolMgr<double, MultiVec, Operator> cg(problem, bp);
   Belos::ReturnType ret;

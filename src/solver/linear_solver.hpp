@@ -1,7 +1,8 @@
 #pragma once
 // The linear-solver layer: Cholmod (SuiteSparse directly, on the matrix's own
 // arrays: solver/cholmod_direct.hpp), KLU2 (Amesos2) or Belos CG with an
-// Ifpack2 preconditioner, configured by the scene's "Linear Solver" sublist.
+// Ifpack2 or a MueLu (solver/muelu_preconditioner.hpp) preconditioner,
+// configured by the scene's "Linear Solver" sublist.
 #include <Teuchos_ParameterList.hpp>
 #include <Teuchos_RCP.hpp>
 #include <memory>
@@ -43,6 +44,14 @@ class LinearSolver {
   // `forcing` > 0 (CG with 'forcing term: adaptive'): the relative residual
   // to reach, clamped to [tolerance, 0.1]; direct solvers ignore it.
   LinearSolveStats solve(const Vector& b, Vector& x, double forcing = 0.0);
+
+  // MueLu: the caller should pass the rigid-body modes of the DOFs' nodes
+  // (rigid_body_modes in solver/muelu_preconditioner.hpp) after every
+  // set_matrix; a new null space means a new hierarchy at the next solve.
+  bool wants_near_null_space() const;
+  void set_near_null_space(const Teuchos::RCP<MultiVec>& modes, int block_size);
+  // MueLu hierarchies created from scratch (0 for the others).
+  int preconditioner_setups() const;
 
   LinearSolverKind kind() const { return kind_; }
   // The tolerance of a solve with forcing 0 ('CG/tolerance'; 0 for direct).

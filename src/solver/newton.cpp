@@ -1,6 +1,7 @@
 #include "solver/newton.hpp"
 
 #include <Kokkos_Timer.hpp>
+#include <Teuchos_CommHelpers.hpp>
 #include <Tpetra_CrsMatrix.hpp>
 #include <Tpetra_Vector.hpp>
 #include <cmath>
@@ -8,6 +9,7 @@
 #include <map>
 #include <sstream>
 
+#include "solver/muelu_preconditioner.hpp"
 #include "solver/solver_error.hpp"
 
 namespace bfemp {
@@ -22,20 +24,27 @@ struct NewtonSolver<dim>::Impl {
   LinearSolver solver;
   DofSpace<dim> dofs;
   Teuchos::RCP<Vector> b, p;
+  Teuchos::RCP<MultiVec> modes;  // MueLu: rigid-body modes on the DOF map
   View1 grad, rhs, dx_prescribed, dir, trial;
   std::map<std::string, double> term_s;  // assembly seconds per term name
 
   Impl(const Teuchos::RCP<const Comm>& c, const Teuchos::ParameterList& ls, NewtonParams np)
-      : comm(c), params(np), solver(ls, c), dofs(c) {
-    if (comm->getSize() > 1)
-      throw std::invalid_argument(
-          "the Newton solver runs on 1 MPI rank in this version (the distributed "
-          "assembly comes with the MPI issue); run without mpirun or with -np 1");
+      : comm(c), params(np), solver(ls, c), dofs(c) {}
+
+  // Global reductions (every rank takes the same step and stops together).
+  double all(double v, Teuchos::EReductionType op) const {
+    if (comm->getSize() == 1) return v;
+    double g = v;
+    Teuchos::reduceAll(*comm, op, v, Teuchos::outArg(g));
+    return g;
   }
+  double all_max(double v) const { return all(v, Teuchos::REDUCE_MAX); }
+  double all_min(double v) const { return all(v, Teuchos::REDUCE_MIN); }
+  double all_sum(double v) const { return all(v, Teuchos::REDUCE_SUM); }
 
   // Vectors for a new node count (grow only when the count changes).
   void resize_vectors() {
-    const std::size_t ndof = dofs.num_dofs();
+    const std::size_t ndof = dofs.num_dofs();  // local (owned + ghost) DOFs
     if (grad.extent(0) == ndof && !b.is_null() && b->getMap() == dofs.map()) return;
     b = Teuchos::rcp(new Vector(dofs.map()));
     p = Teuchos::rcp(new Vector(dofs.map()));
@@ -49,6 +58,16 @@ struct NewtonSolver<dim>::Impl {
   void matrix_changed() {
     solver.set_matrix(dofs.matrix());
     resize_vectors();
+  }
+
+  // MueLu's near-null space: the rigid-body modes of the nodes at x (once per
+  // minimisation and after a graph rebuild; the hierarchy follows it).
+  void refresh_modes(CView1 x) {
+    if (!solver.wants_near_null_space()) return;
+    constexpr int nm = dim == 2 ? 3 : 6;
+    if (modes.is_null() || modes->getMap() != dofs.map()) modes = Teuchos::rcp(new MultiVec(dofs.map(), nm));
+    rigid_body_modes<dim>(x, *modes);
+    solver.set_near_null_space(modes, dim);
   }
 
   // Gradient, projected Hessian and right-hand side at x.
@@ -70,15 +89,18 @@ struct NewtonSolver<dim>::Impl {
     auto mass = ip.mass;
     auto xhat = ip.x_hat;
     auto pres = ip.prescribed;
+    const LO n_own = static_cast<LO>(dofs.num_owned_dofs());  // inertia once, at the owner
     Kokkos::parallel_for(
         "newton_inertia", Kokkos::RangePolicy<ExecSpace>(0, g.extent(0)), KOKKOS_LAMBDA(const LO i) {
-          g(i) += mass(i) * (x(i) - xhat(i));
+          const bool owned = i < n_own;
+          if (owned) g(i) += mass(i) * (x(i) - xhat(i));
           if (pres(i)) return;  // the DOF space writes the constraint row
           r(i) -= g(i);
+          if (!owned) return;
           const double diag = mass(i);
           lcl.sumIntoValues(i, &i, 1, &diag, false, true);
         });
-    dofs.end_assembly(pres, dxp, r);  // prescribed rows, slip transform
+    dofs.end_assembly(pres, dxp, r, *b);  // (export,) prescribed rows, slip transform
   }
 };
 
@@ -91,7 +113,17 @@ template <int dim>
 NewtonSolver<dim>::~NewtonSolver() = default;
 
 template <int dim>
+void NewtonSolver<dim>::set_partition(std::vector<GO> global_nodes, LO n_owned) {
+  impl_->dofs.set_partition(std::move(global_nodes), n_owned);
+}
+
+template <int dim>
 bool NewtonSolver<dim>::set_system(LO n_nodes, std::vector<const EnergyTerm<dim>*> terms) {
+  if (impl_->comm->getSize() > 1 && !impl_->dofs.distributed())
+    throw std::invalid_argument(
+        "the Newton solver runs on " + std::to_string(impl_->comm->getSize()) +
+        " MPI ranks only with a node partition (set_partition); this scene's DOFs are not "
+        "distributed yet: run without mpirun or with -np 1");
   const bool rebuilt = impl_->dofs.set_structure(n_nodes, terms);
   if (rebuilt) impl_->matrix_changed();
   return rebuilt;
@@ -131,7 +163,7 @@ template <int dim>
 double NewtonSolver<dim>::potential(CView1 x) const {
   double e = 0;
   for (const auto* t : impl_->dofs.terms()) e += t->energy(x);
-  return e;
+  return impl_->all_sum(e);  // each stencil lives on one rank
 }
 
 template <int dim>
@@ -146,12 +178,13 @@ typename NewtonSolver<dim>::Energy NewtonSolver<dim>::energy(const IncrementalPo
   auto mass = ip.mass;
   auto xhat = ip.x_hat;
   Kokkos::parallel_reduce(
-      "newton_inertia_energy", Kokkos::RangePolicy<ExecSpace>(0, x.extent(0)),
+      "newton_inertia_energy", Kokkos::RangePolicy<ExecSpace>(0, impl_->dofs.num_owned_dofs()),
       KOKKOS_LAMBDA(const LO i, double& acc) {
         const double d = x(i) - xhat(i);
         acc += 0.5 * mass(i) * d * d;
       },
       E.inertia);
+  E.inertia = impl_->all_sum(E.inertia);
   E.elastic = ip.h * potential(x);
   return E;
 }
@@ -167,6 +200,7 @@ NewtonStats NewtonSolver<dim>::minimize(const IncrementalPotential& ip, View1 x)
   auto dir = m.dir;
   auto trial = m.trial;
   double r0_norm = 0;
+  m.refresh_modes(x);
   for (int it = 0; it < m.params.max_iterations; ++it) {
     // Remaining offset of the prescribed DOFs.
     double pres_left = 0;
@@ -178,13 +212,16 @@ NewtonStats NewtonSolver<dim>::minimize(const IncrementalPotential& ip, View1 x)
         },
         Kokkos::Max<double>(pres_left));
     pres_left = std::max(pres_left, m.dofs.slip().update_offsets(x));  // remaining slip offsets
+    pres_left = m.all_max(pres_left);
 
     timer.reset();
     bool grow = false;
     for (const auto* t : m.dofs.terms()) grow = t->update(x) || grow;
+    grow = m.all_max(grow ? 1.0 : 0.0) > 0;
     if (grow) {
       m.dofs.rebuild();
       m.matrix_changed();
+      m.refresh_modes(x);
       ++st.graph_builds;
     }
     m.assemble(ip, x);
@@ -192,6 +229,7 @@ NewtonStats NewtonSolver<dim>::minimize(const IncrementalPotential& ip, View1 x)
       // A term's couplings were not in the cached graph: never drop them.
       m.dofs.rebuild();
       m.matrix_changed();
+      m.refresh_modes(x);
       m.dofs.count_missing_block_rebuild();
       ++st.graph_builds;
       m.assemble(ip, x);
@@ -202,10 +240,6 @@ NewtonStats NewtonSolver<dim>::minimize(const IncrementalPotential& ip, View1 x)
     st.assembly_s += timer.seconds();
 
     timer.reset();
-    {
-      auto bv = Kokkos::subview(m.b->getLocalViewDevice(Tpetra::Access::OverwriteAll), Kokkos::ALL(), 0);
-      Kokkos::deep_copy(bv, m.rhs);
-    }
     m.p->putScalar(0.0);
     // Inexact Newton (CG): relative residual eta_k = |r_k| / |r_0| (clamped by
     // the linear solver to [tolerance, 0.1]): loose far from the minimum,
@@ -216,10 +250,7 @@ NewtonStats NewtonSolver<dim>::minimize(const IncrementalPotential& ip, View1 x)
     const LinearSolveStats ls = m.solver.solve(*m.b, *m.p, forcing > 0 ? forcing : 1e-300);
     st.linear_iterations += ls.iterations;
     if (ls.refactored) ++st.symbolic_factorizations;
-    {
-      auto pv = Kokkos::subview(m.p->getLocalViewDevice(Tpetra::Access::ReadOnly), Kokkos::ALL(), 0);
-      Kokkos::deep_copy(dir, pv);
-    }
+    m.dofs.to_local(*m.p, dir);
     st.solve_s += timer.seconds();
 
     timer.reset();
@@ -240,12 +271,14 @@ NewtonStats NewtonSolver<dim>::minimize(const IncrementalPotential& ip, View1 x)
           KOKKOS_LAMBDA(const LO i, double& acc) { acc = std::fmax(acc, std::fabs(dir(i)) * (has_w ? wgt(i) : 1.0)); },
           Kokkos::Max<double>(p_inf));
     }
+    p_inf = m.all_max(p_inf);
     if (!std::isfinite(p_inf))
       throw SolverError("Newton direction is not finite (linear solve produced NaN/Inf)");
 
     for (const auto* t : m.dofs.terms()) t->prepare_direction(x, dir);
     double a_max = std::numeric_limits<double>::infinity();
     for (const auto* t : m.dofs.terms()) a_max = std::min(a_max, t->max_step(x, dir));
+    a_max = m.all_min(a_max);
     double alpha = std::min(1.0, 0.9 * a_max);
     bool converged = p_inf / ip.dt < m.params.eps_d && pres_left == 0.0;
     if (converged && ls.tolerance > m.solver.tightest_tolerance()) {
@@ -255,10 +288,7 @@ NewtonStats NewtonSolver<dim>::minimize(const IncrementalPotential& ip, View1 x)
       m.p->putScalar(0.0);
       const LinearSolveStats tight = m.solver.solve(*m.b, *m.p, 0.0);
       st.linear_iterations += tight.iterations;
-      {
-        auto pv = Kokkos::subview(m.p->getLocalViewDevice(Tpetra::Access::ReadOnly), Kokkos::ALL(), 0);
-        Kokkos::deep_copy(dir, pv);
-      }
+      m.dofs.to_local(*m.p, dir);
       p_inf = 0;
       Kokkos::parallel_reduce(
           "newton_dir_norm_tight", Kokkos::RangePolicy<ExecSpace>(0, x.extent(0)),
@@ -274,12 +304,14 @@ NewtonStats NewtonSolver<dim>::minimize(const IncrementalPotential& ip, View1 x)
             KOKKOS_LAMBDA(const LO i, double& acc) { acc = std::fmax(acc, std::fabs(dir(i)) * (has_w ? wgt(i) : 1.0)); },
             Kokkos::Max<double>(p_inf));
       }
+      p_inf = m.all_max(p_inf);
       converged = p_inf / ip.dt < m.params.eps_d;
       st.solve_s += timer.seconds();
       timer.reset();
       for (const auto* t : m.dofs.terms()) t->prepare_direction(x, dir);
       a_max = std::numeric_limits<double>::infinity();
       for (const auto* t : m.dofs.terms()) a_max = std::min(a_max, t->max_step(x, dir));
+      a_max = m.all_min(a_max);
       alpha = std::min(1.0, 0.9 * a_max);
     }
     // Armijo-type backtracking on E while the prescribed DOFs are at their
@@ -290,9 +322,19 @@ NewtonStats NewtonSolver<dim>::minimize(const IncrementalPotential& ip, View1 x)
       const double tol = 1e-13 * scale;  // round-off of the energy sums
       auto grad = m.grad;
       double gp = 0;  // directional derivative of E along p (< 0)
-      Kokkos::parallel_reduce(
-          "newton_grad_dot_p", Kokkos::RangePolicy<ExecSpace>(0, x.extent(0)),
-          KOKKOS_LAMBDA(const LO i, double& acc) { acc += pres(i) ? 0.0 : grad(i) * dir(i); }, gp);
+      if (!m.dofs.distributed()) {
+        Kokkos::parallel_reduce(
+            "newton_grad_dot_p", Kokkos::RangePolicy<ExecSpace>(0, x.extent(0)),
+            KOKKOS_LAMBDA(const LO i, double& acc) { acc += pres(i) ? 0.0 : grad(i) * dir(i); }, gp);
+      } else {
+        // The local gradient holds this rank's part only; the owned rhs is the
+        // summed -grad at free rows.
+        auto bv = Kokkos::subview(m.b->getLocalViewDevice(Tpetra::Access::ReadOnly), Kokkos::ALL(), 0);
+        Kokkos::parallel_reduce(
+            "newton_grad_dot_p_owned", Kokkos::RangePolicy<ExecSpace>(0, m.dofs.num_owned_dofs()),
+            KOKKOS_LAMBDA(const LO i, double& acc) { acc -= pres(i) ? 0.0 : bv(i) * dir(i); }, gp);
+        gp = m.all_sum(gp);
+      }
       while (true) {
         Kokkos::parallel_for(
             "newton_trial", Kokkos::RangePolicy<ExecSpace>(0, x.extent(0)),

@@ -60,6 +60,13 @@ class NewtonSolver {
                NewtonParams params);
   ~NewtonSolver();
 
+  // MPI: this rank's nodes (owned first, then ghosts) and their global ids
+  // (DofSpace::set_partition); before set_system. Every View of minimize()
+  // then covers all local nodes, ghosts included; each term holds only this
+  // rank's stencils (each stencil on one rank), and ip.mass is the global
+  // lumped mass at every local DOF. Without it the solver runs on 1 rank.
+  void set_partition(std::vector<GO> global_nodes, LO n_owned);
+
   // Declares the unknowns (n_nodes * dim DOFs) and the terms of Psi. The DOF
   // space rebuilds the graph (and the linear solver its symbolic phase) only
   // when the node count or a term's couplings changed; returns true then. The

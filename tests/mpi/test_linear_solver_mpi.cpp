@@ -1,4 +1,4 @@
-// The linear-solver layer on a distributed SPD matrix: CG + Ifpack2 gives the
+// The linear-solver layer on a distributed SPD matrix: CG + Ifpack2 or MueLu gives the
 // same answer on 1 and 2 MPI ranks (both runs are checked against the same
 // exact solution), direct solvers are exact on 1 rank and refused on 2.
 #include <gtest/gtest.h>
@@ -65,8 +65,8 @@ double solve_error(const std::string& type, const std::string& prec) {
 
 }  // namespace
 
-TEST(LinearSolverMpi, CgWithIfpack2MatchesExactSolutionOnAnyRankCount) {
-  for (const char* prec : {"RELAXATION", "SCHWARZ", "CHEBYSHEV", "NONE"}) {
+TEST(LinearSolverMpi, CgWithIfpack2OrMueLuMatchesExactSolutionOnAnyRankCount) {
+  for (const char* prec : {"RELAXATION", "SCHWARZ", "CHEBYSHEV", "MUELU", "NONE"}) {
     const double err = solve_error("CG", prec);
     // |x - x_exact| <= cond(A) * tol * |x|; cond ~ 8 / 1e-2 here.
     EXPECT_LT(err, 1e-8) << prec << " on " << Tpetra::getDefaultComm()->getSize() << " rank(s)";
@@ -106,4 +106,20 @@ TEST(LinearSolverMpi, CgNonConvergenceIsAnError) {
   LinearSolver s(ls, comm);
   s.set_matrix(A);
   EXPECT_THROW(s.solve(b, x), SolverError);
+}
+
+TEST(LinearSolverMpi, MisspelledMueLuKeyRefusedOnAnyRankCount) {
+  auto comm = Tpetra::getDefaultComm();
+  Teuchos::ParameterList ls = *linear_solver_schema();
+  ls.set("type", std::string("CG"));
+  ls.sublist("CG").set("preconditioner", std::string("MUELU"));
+  ls.sublist("CG").sublist("MueLu").set("aggregation: typo", 3);
+  try {
+    LinearSolver s(ls, comm);
+    ADD_FAILURE() << "accepted on " << comm->getSize() << " ranks";
+  } catch (const std::invalid_argument& e) {
+    const std::string msg = e.what();
+    EXPECT_NE(msg.find("Linear Solver/CG/MueLu"), std::string::npos) << msg;
+    EXPECT_NE(msg.find("aggregation: typo"), std::string::npos) << msg;
+  }
 }

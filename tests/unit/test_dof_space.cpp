@@ -11,6 +11,7 @@
 #include <gtest/gtest.h>
 
 #include <Tpetra_CrsMatrix.hpp>
+#include <Tpetra_Vector.hpp>
 #include <algorithm>
 #include <random>
 
@@ -360,8 +361,10 @@ TEST(DofSpace, EndAssemblyWritesIdentityRowsForPrescribedDofs) {
   ASSERT_TRUE(space.set_structure(n, {&term}));
   space.begin_assembly();
   term.assemble(x, space.sink(0.5, grad, rhs, p, dx));
-  space.end_assembly(p, dx, rhs);
+  Vector b(space.map());
+  space.end_assembly(p, dx, rhs, b);
   auto A = space.matrix();
+  auto bh = b.getLocalViewHost(Tpetra::Access::ReadOnly);
   long prescribed_rows = 0;
   for (std::size_t i = 0; i < nd; ++i) {
     typename Matrix::local_inds_host_view_type cols;
@@ -376,6 +379,7 @@ TEST(DofSpace, EndAssemblyWritesIdentityRowsForPrescribedDofs) {
       ++prescribed_rows;
       EXPECT_EQ(rhs(i), dxp[i]) << "rhs of prescribed DOF " << i;
     }
+    EXPECT_EQ(bh(i, 0), rhs(i)) << "b, DOF " << i;
   }
   EXPECT_GT(prescribed_rows, 10);
 }
