@@ -123,17 +123,19 @@ int main(int argc, char** argv) {
         if (root) log << bfemp::scene_summary(scene);
         bfemp::run_scene(scene, opt.append ? restart_dir : restart_output, comm, log, opt);
       }
-    } catch (const bfemp::Interrupted& e) {
-      std::cerr << "bfemp: stopped by " << e.what() << "\n";
+    } catch (const bfemp::Interrupted& e) {  // (every rank stops at the same step: rank 0 reports)
+      if (root) std::cerr << "bfemp: stopped by " << e.what() << "\n";
       code = e.exit_code();
-    } catch (const std::invalid_argument& e) {
-      std::cerr << "bfemp: bad input: " << e.what() << "\n";
+    } catch (const std::invalid_argument& e) {  // the same input on every rank
+      if (root) std::cerr << "bfemp: bad input: " << e.what() << "\n";
       code = 2;
-    } catch (const bfemp::SolverError& e) {
-      std::cerr << "bfemp: solver failure at " << e.what() << "\n";
+    } catch (const bfemp::SolverError& e) {  // global decisions: every rank fails together
+      if (root) std::cerr << "bfemp: solver failure at " << e.what() << "\n";
       code = 3;
     } catch (const std::exception& e) {
-      std::cerr << "bfemp: error: " << e.what() << "\n";
+      std::cerr << "bfemp: error";
+      if (comm->getSize() > 1) std::cerr << " on rank " << comm->getRank();
+      std::cerr << ": " << e.what() << "\n";
       code = 1;
     }
   }

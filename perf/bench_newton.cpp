@@ -4,7 +4,7 @@
 // with the Cholmod, KLU2 and CG + Ifpack2 linear solvers. Writes JSON.
 //
 //   bench_newton [--dims 2,3] [--sizes small,medium,large]
-//                [--solvers Cholmod,KLU2,CG] [--cg-preconditioner CHEBYSHEV]
+//                [--solvers Cholmod,KLU2,CG] [--cg-preconditioner CHEBYSHEV|SGS|JACOBI|RILUK|MUELU|NONE]
 //                [--steps N] [--dt 0.05] [--velocity vx,vy[,vz]] [--out newton.json]
 //
 // Threads: Kokkos gets OMP_NUM_THREADS (see perf/run_benchmarks.sh, which runs
@@ -73,7 +73,7 @@ struct Options {
   if (!msg.empty()) os << "bench_newton: " << msg << "\n";
   os << "usage: bench_newton [--dims 2,3] [--sizes small,medium,large]\n"
         "                    [--solvers Cholmod,KLU2,CG] [--cg-preconditioner "
-        "SGS|JACOBI|CHEBYSHEV|RILUK|NONE]\n"
+        "SGS|JACOBI|CHEBYSHEV|RILUK|MUELU|NONE]\n"
         "                    [--steps N] [--dt SECONDS] [--velocity vx,vy[,vz]]\n"
         "                    [--no-skip] [--mesh-only] [--out FILE]\n";
   std::exit(msg.empty() ? 0 : 2);
@@ -106,7 +106,7 @@ Options parse(int argc, char** argv) {
     } else if (a == "--cg-preconditioner") {
       o.cg_prec = value();
       if (o.cg_prec != "SGS" && o.cg_prec != "JACOBI" && o.cg_prec != "CHEBYSHEV" &&
-          o.cg_prec != "RILUK" && o.cg_prec != "NONE")
+          o.cg_prec != "RILUK" && o.cg_prec != "MUELU" && o.cg_prec != "NONE")
         usage("--cg-preconditioner: '" + o.cg_prec + "'");
     } else if (a == "--steps") {
       o.steps = std::stoi(value());
@@ -173,6 +173,8 @@ Teuchos::ParameterList linear_solver_list(const std::string& solver, const std::
   } else if (prec == "RILUK") {
     cg.set("preconditioner", "RILUK");
     ifp.set("fact: iluk level-of-fill", 0);
+  } else if (prec == "MUELU") {
+    cg.set("preconditioner", "MUELU");  // bfemp's MueLu defaults (smoothed aggregation, rigid-body modes)
   } else {
     cg.set("preconditioner", "NONE");
   }
@@ -184,6 +186,7 @@ std::string prec_description(const std::string& prec) {
   if (prec == "JACOBI") return "Ifpack2 RELAXATION, relaxation: type = Jacobi, 1 sweep";
   if (prec == "CHEBYSHEV") return "Ifpack2 CHEBYSHEV, chebyshev: degree = 3";
   if (prec == "RILUK") return "Ifpack2 RILUK, fact: iluk level-of-fill = 0";
+  if (prec == "MUELU") return "MueLu smoothed aggregation, rigid-body near-null space, bfemp defaults";
   return "none";
 }
 

@@ -149,7 +149,7 @@ int global_signal(const Teuchos::RCP<const Comm>& comm) {
 
 template <int dim>
 RunSummary run_dim(const Scene& scene, const std::string& dir, const Teuchos::RCP<const Comm>& comm,
-                   std::ostream& log, const RunOptions& opt) {
+                   std::ostream& log_root, const RunOptions& opt) {
   Kokkos::Timer wall;
   const RunControl rc = scene.run_control();
   const int checkpoint_every = scene.params.sublist("Output").get<int>("checkpoint every");
@@ -159,6 +159,9 @@ RunSummary run_dim(const Scene& scene, const std::string& dir, const Teuchos::RC
   if (opt.restart && opt.restart->dim != dim)
     throw std::invalid_argument("restart: the checkpoint is " + std::to_string(opt.restart->dim) +
                                 "D, the scene " + std::to_string(dim) + "D");
+  const bool root = comm->getRank() == 0;
+  std::ostream null_log(nullptr);
+  std::ostream& log = root ? log_root : null_log;  // one banner, one summary
   Simulation<dim> sim(build_setup<dim>(scene), comm);
   if (opt.restart) {
     check_same_mesh(*opt.restart, sim);
@@ -171,6 +174,19 @@ RunSummary run_dim(const Scene& scene, const std::string& dir, const Teuchos::RC
     log << "; MPM: " << mpm->particles().size() << " particles, " << transfer_scheme_name(mpm->scheme())
         << ", grid " << mpm->grid().num_nodes() << " nodes (dx " << mpm->grid().dx << ")";
   log << "; linear solver: " << sim.newton().linear_solver().describe() << "\n";
+  if (const FemPartition* part = sim.partition()) {
+    // Per-rank work: elements (assembly) and owned DOFs (solve); imbalance = max / mean.
+    const double mine[2] = {static_cast<double>(part->elements.size()), static_cast<double>(part->n_owned) * dim};
+    double lo[2], hi[2], sum[2];
+    Teuchos::reduceAll(*comm, Teuchos::REDUCE_MIN, 2, mine, lo);
+    Teuchos::reduceAll(*comm, Teuchos::REDUCE_MAX, 2, mine, hi);
+    Teuchos::reduceAll(*comm, Teuchos::REDUCE_SUM, 2, mine, sum);
+    const int n = comm->getSize();
+    log << "MPI: " << n << " ranks (Zoltan2 RCB of the elements; FEM state replicated): elements per rank "
+        << lo[0] << ".." << hi[0] << " (imbalance " << std::setprecision(3) << hi[0] / (sum[0] / n)
+        << "), owned DOFs per rank " << lo[1] << ".." << hi[1] << " (imbalance " << hi[1] / (sum[1] / n)
+        << ")\n" << std::setprecision(6);
+  }
   {
     std::string names;
     for (const auto& n : sim.term_names()) names += (names.empty() ? "" : ", ") + n;
@@ -180,9 +196,11 @@ RunSummary run_dim(const Scene& scene, const std::string& dir, const Teuchos::RC
   if (opt.restart && opt.append) resume = {opt.restart->frames, opt.restart->step};
   // A new output must not keep an older run's checkpoint: restarting from it
   // would mix that run's state with this run's frames.
-  if (!(opt.restart && opt.append)) std::filesystem::remove(dir + "/checkpoint.h5");
-  RunOutput<dim> out(dir, scene, sim, opt.restart && opt.append ? &resume : nullptr);
-  if (!(opt.restart && opt.append)) out.write_frame(sim);
+  // Rank 0 writes every file (the state is replicated).
+  if (root && !(opt.restart && opt.append)) std::filesystem::remove(dir + "/checkpoint.h5");
+  std::unique_ptr<RunOutput<dim>> out_ptr;
+  if (root) out_ptr = std::make_unique<RunOutput<dim>>(dir, scene, sim, opt.restart && opt.append ? &resume : nullptr);
+  if (root && !(opt.restart && opt.append)) out_ptr->write_frame(sim);
   if (opt.restart)
     log << "restart: from step " << opt.restart->step << " (t = " << opt.restart->time << " s), "
         << (opt.append ? "appending to " : "new output in ") << dir << "\n";
@@ -190,7 +208,7 @@ RunSummary run_dim(const Scene& scene, const std::string& dir, const Teuchos::RC
   RunSummary s;
   s.contact = sim.contact() != nullptr;
   auto checkpoint = [&] {
-    write_checkpoint(ck_path, make_checkpoint(scene, opt, sim, out.frames_written()));
+    if (root) write_checkpoint(ck_path, make_checkpoint(scene, opt, sim, out_ptr->frames_written()));
     s.checkpoints++;
   };
   const double dt = scene.params.sublist("Time").get<double>("dt");
@@ -200,12 +218,12 @@ RunSummary run_dim(const Scene& scene, const std::string& dir, const Teuchos::RC
   if (opt.handle_signals) guard = std::make_unique<InterruptGuard>();
   for (long n = first; n < n_steps; ++n) {
     const StepReport r = sim.step();
-    out.write_diagnostics(r);
+    if (root) out_ptr->write_diagnostics(r);
     accumulate(s, r);
     // A signal during the last step: the run is complete; finish normally.
     const int sig = guard && n + 1 < n_steps ? global_signal(comm) : 0;
     const bool framed = (n + 1) % rc.output_every == 0 || n + 1 == n_steps || sig;
-    if (framed) out.write_frame(sim);
+    if (framed && root) out_ptr->write_frame(sim);
     if (sig || (checkpoint_every > 0 && (n + 1) % checkpoint_every == 0 && n + 1 < n_steps)) checkpoint();
     if (rc.progress_every > 0 && ((n + 1) % rc.progress_every == 0 || n + 1 == n_steps)) {
       const double el = wall.seconds();
@@ -218,7 +236,7 @@ RunSummary run_dim(const Scene& scene, const std::string& dir, const Teuchos::RC
     }
     if (sig) {
       try {
-        out.close();
+        if (root) out_ptr->close();
       } catch (const std::exception& e) {
         log << "warning: closing the output after the signal failed: " << e.what() << "\n";
       }
@@ -229,8 +247,8 @@ RunSummary run_dim(const Scene& scene, const std::string& dir, const Teuchos::RC
     }
   }
   checkpoint();
-  out.close();
-  s.frames = out.frames_written();
+  if (root) out_ptr->close();
+  s.frames = root ? out_ptr->frames_written() : 0;
   s.wall_s = wall.seconds();
   for (const auto& [name, sec] : sim.newton().term_assembly_seconds()) s.term_assembly_s.emplace_back(name, sec);
   s.graph_builds = sim.newton().dof_space().graph_builds();
@@ -275,6 +293,7 @@ RunSummary run_scene(const Scene& scene, const std::string& dir, const Teuchos::
   }
   RunSummary s = scene.dim() == 2 ? run_dim<2>(scene, dir, comm, log, options)
                                   : run_dim<3>(scene, dir, comm, log, options);
+  if (comm->getRank() != 0) return s;
   log << "\nsummary\n"
       << "  steps               " << s.steps << "\n"
       << "  Newton iterations   " << s.newton_iterations << " (" << std::setprecision(3)

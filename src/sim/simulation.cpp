@@ -3,6 +3,7 @@
 #include <limits>
 
 #include <Kokkos_Timer.hpp>
+#include <Teuchos_CommHelpers.hpp>
 #include <iostream>
 #include <sstream>
 
@@ -46,13 +47,40 @@ Simulation<dim>::Simulation(SimulationSetup<dim> setup, const Teuchos::RCP<const
         KOKKOS_LAMBDA(const std::size_t q, double& acc) { acc = pm(q) < acc ? pm(q) : acc; }, Kokkos::Min<double>(m));
     mpm_min_particle_mass_ = std::isfinite(m) ? m : 0.0;
   }
+  comm_ = comm;
+  if (comm->getSize() > 1 && setup_.mpm)
+    throw std::invalid_argument("this scene has MPM bodies, which run on 1 MPI rank in this version (the "
+                                "distributed particles and grid are not built yet); this run has " +
+                                std::to_string(comm->getSize()) + " ranks: run it without mpirun or with -np 1");
   newton_ = std::make_unique<NewtonSolver<dim>>(comm, setup_.linear_solver, setup_.newton);
   sys_ = std::make_unique<System>();
+  if (comm->getSize() > 1) {
+    // FEM only: cut the elements into the ranks; Newton runs on this rank's piece.
+    distributed_ = true;
+    part_ = partition_fem_mesh<dim>(mesh_, comm);
+    const FemMesh<dim> local = local_fem_mesh<dim>(mesh_, part_);
+    local_elasticity_ = std::make_unique<DeformationTerm<dim, dim + 1>>("fem elasticity", local.elements);
+    if (local.num_cells() > 0)
+      local_elasticity_->set_coloring(color_stencils<dim + 1>(local.elements.nodes, local.num_nodes()));
+    const std::size_t nl = part_.nodes.size() * dim;
+    local_dof_ = Kokkos::View<LO*, MemSpace>("fem_local_dof", nl);
+    auto ld = Kokkos::create_mirror_view(local_dof_);
+    for (std::size_t a = 0; a < part_.nodes.size(); ++a)
+      for (int c = 0; c < dim; ++c) ld(a * dim + c) = static_cast<LO>(part_.nodes[a] * dim + c);
+    Kokkos::deep_copy(local_dof_, ld);
+    lx_ = View1("fem_local_x", nl);
+    lxhat_ = View1("fem_local_xhat", nl);
+    lmass_ = View1("fem_local_mass", nl);
+    ltarget_ = View1("fem_local_target", nl);
+    lpres_ = Kokkos::View<int*, MemSpace>("fem_local_prescribed", nl);
+    newton_->set_partition(part_.nodes, part_.n_owned);
+    newton_->set_system(static_cast<LO>(part_.nodes.size()), {local_elasticity_.get()});
+  }
   if (setup_.level_sets.size() > static_cast<std::size_t>(kMaxLevelSets))
     throw std::invalid_argument("scene has " + std::to_string(setup_.level_sets.size()) +
                                 " level sets; expected at most " + std::to_string(kMaxLevelSets));
   for (const auto& ls : setup_.level_sets) level_sets_.sets[level_sets_.count++] = ls;
-  if (!mpm_) newton_->set_system(mesh_.num_nodes(), {elasticity_.get()});
+  if (!mpm_ && !distributed_) newton_->set_system(mesh_.num_nodes(), {elasticity_.get()});
   const std::size_t n = static_cast<std::size_t>(mesh_.num_nodes()) * dim;
   x_ = View1("fem_x", n);
   v_ = View1("fem_v", n);
@@ -128,7 +156,8 @@ void Simulation<dim>::reset_acceleration() {
   auto m = mass_;
   auto pres = prescribed_;
   Kokkos::deep_copy(a, 0.0);
-  newton_->potential_gradient(x_, -1.0, a);
+  if (distributed_) elasticity_->gradient(x_, -1.0, a);  // the replicated whole mesh (Newton's term is local)
+  else newton_->potential_gradient(x_, -1.0, a);
   const auto g = setup_.gravity;
   Kokkos::parallel_for(
       "fem_a0", Kokkos::RangePolicy<ExecSpace>(0, a.extent(0)), KOKKOS_LAMBDA(const LO i) {
@@ -290,7 +319,7 @@ StepReport Simulation<dim>::step() {
           });
       ns = minimize_with_friction(ip, x, xref, s, friction_iters);
     } else {
-      ns = newton_->minimize(ip, x);
+      ns = distributed_ ? minimize_distributed(ip, x, System::head(S.work, nd)) : newton_->minimize(ip, x);
       friction_iters = 1;
     }
   } catch (const SolverError& e) {
@@ -340,6 +369,35 @@ StepReport Simulation<dim>::step() {
   if (setup_.count_penetrations && mpm_) count_penetrations(r);
   r.step_s = timer.seconds();
   return r;
+}
+
+template <int dim>
+NewtonStats Simulation<dim>::minimize_distributed(const IncrementalPotential& ip, View1 x, View1 work) {
+  const auto ld = local_dof_;
+  auto lx = lx_, lxh = lxhat_, lm = lmass_, lt = ltarget_;
+  auto lp = lpres_;
+  const auto xh = ip.x_hat, m = ip.mass, t = ip.target;
+  const auto p = ip.prescribed;
+  Kokkos::parallel_for(
+      "fem_gather_local", Kokkos::RangePolicy<ExecSpace>(0, ld.extent(0)), KOKKOS_LAMBDA(const LO k) {
+        const LO i = ld(k);
+        lx(k) = x(i);
+        lxh(k) = xh(i);
+        lm(k) = m(i);
+        lt(k) = t(i);
+        lp(k) = p(i);
+      });
+  IncrementalPotential lip{lxhat_, lmass_, lpres_, ltarget_, ip.h, ip.dt};
+  const NewtonStats st = newton_->minimize(lip, lx_);
+  // Each rank's owned DOFs into the replicated x (a sum: every DOF has one owner).
+  const LO n_own = static_cast<LO>(part_.n_owned) * dim;
+  Kokkos::deep_copy(work, 0.0);
+  Kokkos::parallel_for(
+      "fem_scatter_owned", Kokkos::RangePolicy<ExecSpace>(0, n_own),
+      KOKKOS_LAMBDA(const LO k) { work(ld(k)) = lx(k); });
+  Kokkos::fence();
+  Teuchos::reduceAll(*comm_, Teuchos::REDUCE_SUM, static_cast<int>(x.extent(0)), work.data(), x.data());
+  return st;
 }
 
 template <int dim>

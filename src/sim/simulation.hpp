@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "fem/fem_mesh.hpp"
+#include "fem/fem_partition.hpp"
 #include "contact/contact.hpp"
 #include "fem/prescribed_motion.hpp"
 #include "mpm/level_set.hpp"
@@ -112,6 +113,11 @@ class Simulation {
   double time() const { return time_; }
   long step_index() const { return step_; }
   const FemMesh<dim>& mesh() const { return mesh_; }
+  // MPI (more than one rank; FEM-only scenes): the element partition the
+  // Newton step runs on (nullptr on 1 rank). The FEM state (positions,
+  // velocities, the mesh) stays replicated on every rank in this version;
+  // each rank assembles and solves only its piece.
+  const FemPartition* partition() const { return distributed_ ? &part_ : nullptr; }
   MpmBodies<dim>* mpm() { return mpm_.get(); }
   const MpmBodies<dim>* mpm() const { return mpm_.get(); }
   NewtonSolver<dim>& newton() { return *newton_; }
@@ -135,6 +141,9 @@ class Simulation {
   void apply_prescribed_targets(double t, Kokkos::View<double*, MemSpace> target) const;
   void prescribed_velocities(double t1);
   void count_penetrations(StepReport& r);
+  // MPI: Newton on this rank's nodes, the result summed into every rank's x.
+  NewtonStats minimize_distributed(const IncrementalPotential& ip, Kokkos::View<double*, MemSpace> x,
+                                   Kokkos::View<double*, MemSpace> work);
   NewtonStats minimize_with_friction(const IncrementalPotential& ip, Kokkos::View<double*, MemSpace> x,
                                      Kokkos::View<double*, MemSpace> x_ref, double s, int& iterations);
 
@@ -153,6 +162,15 @@ class Simulation {
   double time_ = 0;
   long step_ = 0;
   double mpm_min_particle_mass_ = 0;  // the weight scale of the Newton convergence test
+  // MPI: the partition, this rank's elasticity (local node ids), the global
+  // DOF of each local DOF, and the local copies of the step's inputs.
+  Teuchos::RCP<const Comm> comm_;
+  bool distributed_ = false;
+  FemPartition part_;
+  std::unique_ptr<DeformationTerm<dim, dim + 1>> local_elasticity_;
+  Kokkos::View<LO*, MemSpace> local_dof_;
+  Kokkos::View<double*, MemSpace> lx_, lxhat_, lmass_, ltarget_;
+  Kokkos::View<int*, MemSpace> lpres_;
 };
 
 }  // namespace bfemp

@@ -1,0 +1,109 @@
+// An FEM-only Simulation on the ranks of the default communicator (its
+// elements cut by Zoltan2 RCB, the Newton step distributed, the FEM state
+// replicated) equals the same scene run by each rank alone (MPI_COMM_SELF):
+// positions, velocities and energies after 6 steps of a squashed neo-Hookean
+// block with gravity, in 2D and 3D, with CG + Ifpack2 and CG + MueLu; and
+// every rank reports the same Newton iterations. MPM scenes are refused on
+// more than one rank.
+#include <gtest/gtest.h>
+
+#include <Teuchos_CommHelpers.hpp>
+#include <Teuchos_DefaultMpiComm.hpp>
+#include <Tpetra_Core.hpp>
+#include <cmath>
+#include <mpi.h>
+
+#include "common/fem_fixtures.hpp"
+#include "common/mpm_fixtures.hpp"
+
+using namespace bfemp;
+
+namespace {
+
+struct Result {
+  std::vector<double> x, v;
+  std::vector<int> iterations;
+  double kinetic = 0, elastic = 0;
+};
+
+template <int dim>
+Result run(const Teuchos::RCP<const Comm>& comm, const std::string& prec) {
+  auto setup = fixtures::block_setup<dim>(dim == 2 ? 0.08 : 0.25, 1e5, 0.35, 1000.0, 1.0, "CG");
+  setup.dt = 1e-2;
+  setup.gravity = {0.0, -9.81, 0.0};
+  setup.newton.eps_d = 1e-9;
+  setup.linear_solver.sublist("CG").set("preconditioner", prec);
+  setup.linear_solver.sublist("CG").set("tolerance", 1e-13);
+  if (prec == "RELAXATION")
+    setup.linear_solver.sublist("CG").sublist("Ifpack2").set("relaxation: type", std::string("Symmetric Gauss-Seidel"));
+  fixtures::prescribe<dim>(setup, "bottom");
+  MotionSegment down;
+  down.type = MotionType::Velocity;
+  down.velocity = {0.0, -1.0, 0.0};
+  fixtures::prescribe<dim>(setup, "top", {down});
+  Simulation<dim> sim(setup, comm);
+  Result r;
+  for (int s = 0; s < 6; ++s) {
+    const StepReport rep = sim.step();
+    r.iterations.push_back(rep.newton.iterations);
+    r.kinetic = rep.kinetic;
+    r.elastic = rep.elastic;
+  }
+  auto x = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), sim.positions());
+  auto v = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), sim.velocities());
+  r.x.assign(x.data(), x.data() + x.extent(0));
+  r.v.assign(v.data(), v.data() + v.extent(0));
+  return r;
+}
+
+template <int dim>
+void distributed_equals_alone(const std::string& prec) {
+  auto world = Tpetra::getDefaultComm();
+  Teuchos::RCP<const Comm> self = Teuchos::rcp(new Teuchos::MpiComm<int>(MPI_COMM_SELF));
+  const Result d = run<dim>(world, prec);
+  const Result s = run<dim>(self, prec);
+  ASSERT_EQ(d.x.size(), s.x.size());
+  double ex = 0, ev = 0, vs = 0;
+  for (std::size_t i = 0; i < d.x.size(); ++i) {
+    ex = std::max(ex, std::abs(d.x[i] - s.x[i]));
+    ev = std::max(ev, std::abs(d.v[i] - s.v[i]));
+    vs = std::max(vs, std::abs(s.v[i]));
+  }
+  // Newton stops at |p|_inf / dt < 1e-9 m/s (dt 1e-2): 1e-11 m per coordinate.
+  EXPECT_LT(ex, 1e-9) << dim << "D " << prec;
+  EXPECT_LT(ev, 1e-7 * vs) << dim << "D " << prec;
+  EXPECT_NEAR(d.kinetic, s.kinetic, 1e-8 * s.kinetic);
+  EXPECT_NEAR(d.elastic, s.elastic, 1e-8 * s.elastic);
+  // Every rank took the same Newton iterations in every step.
+  for (int it : d.iterations) {
+    int lo = 0, hi = 0;
+    Teuchos::reduceAll(*world, Teuchos::REDUCE_MIN, it, Teuchos::outArg(lo));
+    Teuchos::reduceAll(*world, Teuchos::REDUCE_MAX, it, Teuchos::outArg(hi));
+    EXPECT_EQ(lo, hi);
+  }
+  if (world->getRank() == 0) {
+    int total = 0;
+    for (int it : d.iterations) total += it;
+    std::cout << dim << "D squash, " << world->getSize() << " rank(s), CG + " << prec << ": |x - x_alone| = " << ex
+              << " m, |v - v_alone| = " << ev << " m/s, " << total << " Newton iterations in 6 steps\n";
+  }
+}
+
+}  // namespace
+
+TEST(SimulationMpi, FemSquash2DRelaxationEqualsOneRank) { distributed_equals_alone<2>("RELAXATION"); }
+TEST(SimulationMpi, FemSquash2DMueLuEqualsOneRank) { distributed_equals_alone<2>("MUELU"); }
+TEST(SimulationMpi, FemSquash3DMueLuEqualsOneRank) { distributed_equals_alone<3>("MUELU"); }
+
+TEST(SimulationMpi, MpmSceneRefusedOnSeveralRanks) {
+  auto world = Tpetra::getDefaultComm();
+  if (world->getSize() == 1) GTEST_SKIP() << "needs 2 ranks";
+  auto setup = fixtures::mpm_block_setup(0.4, Vec<2>(0.5, 0.5), 0.1, 4, 0.0, 1.0, TransferScheme::APIC);
+  setup.linear_solver.set("type", std::string("CG"));
+  try {
+    Simulation<2> sim(setup, world);
+    FAIL() << "an MPM scene was accepted on " << world->getSize() << " ranks";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("MPM"), std::string::npos) << e.what();
+  }
+}
