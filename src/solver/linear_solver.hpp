@@ -47,8 +47,10 @@ class LinearSolver {
 
   // MueLu: the caller should pass the rigid-body modes of the DOFs' nodes
   // (rigid_body_modes in solver/muelu_preconditioner.hpp) after every
-  // set_matrix; a new null space means a new hierarchy at the next solve.
+  // set_matrix and every near_null_space_every() minimisations; a new null
+  // space means a new hierarchy at the next solve.
   bool wants_near_null_space() const;
+  int near_null_space_every() const;
   void set_near_null_space(const Teuchos::RCP<MultiVec>& modes, int block_size);
   // MueLu hierarchies created from scratch (0 for the others).
   int preconditioner_setups() const;

@@ -23,8 +23,13 @@ namespace {
 Teuchos::ParameterList with_defaults(const Teuchos::ParameterList& user, int ranks) {
   Teuchos::ParameterList p("MueLu");
   p.set("verbosity", "none");
-  p.set("multigrid algorithm", "sa");
-  p.set("reuse: type", "none");
+  // Measured on the clamped blocks of perf/bench_newton (1e5 DOFs, 1 thread,
+  // per Newton iteration): unsmoothed aggregation with P and R kept across
+  // solves costs 0.81 s (2D) and 3.1 s (3D), against 1.56 s and 19.9 s for
+  // smoothed aggregation rebuilt every solve (its RAP with 6 modes per
+  // aggregate dominates in 3D), 6.05 s and 4.49 s for Ifpack2 Chebyshev.
+  p.set("multigrid algorithm", "unsmoothed");
+  p.set("reuse: type", "RP");
   if (ranks > 1 && !user.isParameter("coarse: type")) {
     p.set("coarse: type", "RELAXATION");
     auto& cp = p.sublist("coarse: params");
@@ -117,6 +122,13 @@ void MueLuPreconditioner::compute() {
 }
 
 RCP<Operator> MueLuPreconditioner::op() const { return impl_->prec; }
+
+std::string MueLuPreconditioner::describe() const {
+  const auto& p = impl_->params;
+  std::string coarse = p.isParameter("coarse: type") ? p.get<std::string>("coarse: type") : "KLU2";
+  return "MueLu (" + p.get<std::string>("multigrid algorithm") + " aggregation on the rigid-body modes, reuse " +
+         p.get<std::string>("reuse: type") + ", coarse " + coarse + ")";
+}
 
 int MueLuPreconditioner::levels() const {
   if (impl_->prec.is_null()) return 0;

@@ -1,9 +1,11 @@
 #pragma once
-// Algebraic multigrid for Belos CG: a MueLu hierarchy (smoothed aggregation by
-// default) built on the Newton matrix A.
+// Algebraic multigrid for Belos CG: a MueLu hierarchy (aggregation on the
+// rigid-body modes; by default unsmoothed, with P and R kept across solves:
+// the fastest of the variants measured, see with_defaults) built on the
+// Newton matrix A.
 //
 // Near-null space. For elasticity the smooth error of A lies near the rigid-
-// body modes of the nodes, and smoothed aggregation interpolates exactly the
+// body modes of the nodes, and aggregation AMG interpolates exactly the
 // vectors it is given: with node positions x_a (node-interleaved DOFs
 // a dim + c), the modes are the translations t_k (1 in component k) and the
 // infinitesimal rotations r = omega x (x_a - x_c) about the centroid x_c:
@@ -13,10 +15,13 @@
 //
 // Set-up cost: the hierarchy is created on the first compute() after a new
 // matrix graph or near-null space; later compute() calls (new values on the
-// same graph: the next Newton iteration) go through
+// same graph: the next Newton iteration or step) go through
 // MueLu::ReuseTpetraPreconditioner, which keeps what "reuse: type" says
 // ("none": rebuild all levels; "tP": keep the aggregates and the tentative
-// prolongator; see the MueLu user guide).
+// prolongator; "RP", bfemp's default: keep P and R, recompute the coarse
+// operators and smoothers; see the MueLu user guide). The Newton solver hands
+// new modes (hence a new hierarchy) after a graph rebuild and every
+// 'Linear Solver/CG/MueLu rebuild every' solves.
 //
 // Coarse solve: MueLu's Amesos2 KLU2 on 1 rank; on more ranks 4 symmetric
 // Gauss-Seidel sweeps (KLU2 is wrong on several ranks in Trilinos 13.2), unless
@@ -49,6 +54,7 @@ class MueLuPreconditioner {
   // Levels of the last hierarchy (0 before the first compute).
   int levels() const;
   int setups() const { return setups_; }
+  std::string describe() const;
   int reuses() const { return reuses_; }
 
  private:

@@ -25,6 +25,8 @@ struct NewtonSolver<dim>::Impl {
   DofSpace<dim> dofs;
   Teuchos::RCP<Vector> b, p;
   Teuchos::RCP<MultiVec> modes;  // MueLu: rigid-body modes on the DOF map
+  bool modes_stale = true;       // MueLu: the matrix changed since the modes were set
+  int solves_since_modes = 0;    // minimisations on the current modes
   View1 grad, rhs, dx_prescribed, dir, trial;
   std::map<std::string, double> term_s;  // assembly seconds per term name
 
@@ -58,12 +60,16 @@ struct NewtonSolver<dim>::Impl {
   void matrix_changed() {
     solver.set_matrix(dofs.matrix());
     resize_vectors();
+    modes_stale = true;
   }
 
-  // MueLu's near-null space: the rigid-body modes of the nodes at x (once per
-  // minimisation and after a graph rebuild; the hierarchy follows it).
+  // MueLu's near-null space: the rigid-body modes of the nodes at x, after a
+  // graph rebuild and every near_null_space_every() minimisations (a new
+  // hierarchy follows; in between it is reused).
   void refresh_modes(CView1 x) {
     if (!solver.wants_near_null_space()) return;
+    modes_stale = false;
+    solves_since_modes = 0;
     constexpr int nm = dim == 2 ? 3 : 6;
     if (modes.is_null() || modes->getMap() != dofs.map()) modes = Teuchos::rcp(new MultiVec(dofs.map(), nm));
     rigid_body_modes<dim>(x, *modes);
@@ -200,7 +206,7 @@ NewtonStats NewtonSolver<dim>::minimize(const IncrementalPotential& ip, View1 x)
   auto dir = m.dir;
   auto trial = m.trial;
   double r0_norm = 0;
-  m.refresh_modes(x);
+  if (m.modes_stale || ++m.solves_since_modes >= m.solver.near_null_space_every()) m.refresh_modes(x);
   for (int it = 0; it < m.params.max_iterations; ++it) {
     // Remaining offset of the prescribed DOFs.
     double pres_left = 0;

@@ -3,8 +3,8 @@
 //    modes of the FEM elasticity (E(X + eps r) = O(eps^4) for each mode, O(eps^2)
 //    for a stretch), in 2D and 3D;
 //  - Newton with CG + MueLu reaches the Cholmod solution of a compressed block
-//    to solver tolerance, builds one hierarchy per step and reuses it across
-//    the step's Newton iterations;
+//    to solver tolerance, builds a hierarchy on new rigid-body modes every
+//    'MueLu rebuild every' steps and reuses it in between;
 //  - a misspelled MueLu key stops at construction, naming the sublist and key.
 #include <gtest/gtest.h>
 
@@ -57,7 +57,7 @@ void modes_are_zero_energy(double h) {
 
 template <int dim>
 std::vector<double> squash(const std::string& solver, const std::string& prec, int* setups = nullptr,
-                           int* newton_its = nullptr) {
+                           int* newton_its = nullptr, int rebuild_every = 10) {
   auto setup = fixtures::block_setup<dim>(dim == 2 ? 0.1 : 0.25, 1e5, 0.35, 1000.0, 1.0, solver);
   setup.dt = 1e-2;
   setup.newton.eps_d = 1e-9;
@@ -69,6 +69,10 @@ std::vector<double> squash(const std::string& solver, const std::string& prec, i
   if (solver == "CG") {
     setup.linear_solver.sublist("CG").set("preconditioner", prec);
     setup.linear_solver.sublist("CG").set("tolerance", 1e-13);
+    setup.linear_solver.sublist("CG").set("MueLu rebuild every", rebuild_every);
+    // A small coarse size, so that these small blocks get a real multilevel
+    // hierarchy (by default they would be one level: a direct solve).
+    setup.linear_solver.sublist("CG").sublist("MueLu").set("coarse: max size", 60);
     if (getenv("MUELU_VERB")) setup.linear_solver.sublist("CG").sublist("MueLu").set("verbosity", std::string(getenv("MUELU_VERB")));
   }
   Simulation<dim> sim(setup, fixtures::comm());
@@ -84,14 +88,20 @@ template <int dim>
 void muelu_matches_cholmod() {
   const auto ref = squash<dim>("Cholmod", "NONE");
   int setups = 0, its = 0;
-  const auto mg = squash<dim>("CG", "MUELU", &setups, &its);
+  const auto mg = squash<dim>("CG", "MUELU", &setups, &its, 2);
   ASSERT_EQ(ref.size(), mg.size());
   double err = 0;
   for (std::size_t i = 0; i < ref.size(); ++i) err = std::max(err, std::abs(ref[i] - mg[i]));
   // Both stop at |p|_inf / dt < 1e-9 m/s (dt 1e-2): 1e-11 m per iterate;
   // against a 5 cm squash.
   EXPECT_LT(err, 1e-9) << dim << "D";
-  EXPECT_EQ(setups, 5) << "one hierarchy per step (new near-null space), reused within it";
+  // New modes (a new hierarchy) at steps 1, 3, 5 ('MueLu rebuild every' 2),
+  // the hierarchy reused in between (the graph never changes here).
+  EXPECT_EQ(setups, 3);
+  int setups10 = 0;
+  const auto mg10 = squash<dim>("CG", "MUELU", &setups10, nullptr, 10);
+  EXPECT_EQ(setups10, 1) << "one hierarchy for 5 steps with 'MueLu rebuild every' 10";
+  for (std::size_t i = 0; i < ref.size(); ++i) ASSERT_LT(std::abs(ref[i] - mg10[i]), 1e-9) << i;
   EXPECT_GT(its, 5);
   std::cout << dim << "D squash: |x_MueLu - x_Cholmod|_inf = " << err << " m, " << its
             << " Newton iterations, " << setups << " MueLu set-ups\n";
@@ -122,4 +132,24 @@ TEST(MueLu, MisspelledKeyStopsAtConstruction) {
   ls.sublist("CG").sublist("MueLu").remove("smoother: tipe");
   ls.sublist("CG").sublist("MueLu").set("smoother: type", std::string("CHEBYSHEV"));
   EXPECT_NO_THROW(LinearSolver(ls, fixtures::comm()));
+}
+
+TEST(MueLu, DefaultForCgAndKeysOfTheOtherPreconditionerRefused) {
+  Teuchos::ParameterList ls = *linear_solver_schema();
+  EXPECT_EQ(ls.sublist("CG").get<std::string>("preconditioner"), "MUELU") << "CG's default, by measurement";
+  ls.set("type", std::string("CG"));
+  ls.sublist("CG").sublist("Ifpack2").set("relaxation: sweeps", 2);
+  try {
+    LinearSolver s(ls, fixtures::comm());
+    FAIL() << "Ifpack2 keys accepted with MUELU";
+  } catch (const std::invalid_argument& e) {
+    const std::string msg = e.what();
+    EXPECT_NE(msg.find("Linear Solver/CG/Ifpack2"), std::string::npos) << msg;
+    EXPECT_NE(msg.find("relaxation: sweeps"), std::string::npos) << msg;
+  }
+  Teuchos::ParameterList ls2 = *linear_solver_schema();
+  ls2.set("type", std::string("CG"));
+  ls2.sublist("CG").set("preconditioner", std::string("CHEBYSHEV"));
+  ls2.sublist("CG").sublist("MueLu").set("coarse: max size", 100);
+  EXPECT_THROW(LinearSolver(ls2, fixtures::comm()), std::invalid_argument);
 }
