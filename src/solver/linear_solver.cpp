@@ -88,13 +88,15 @@ Teuchos::RCP<const Teuchos::ParameterList> linear_solver_schema() {
          rcp(new Teuchos::EnhancedNumberValidator<int>(1, 1000000)));
   cg.set("max iterations", 2000, "CG iteration cap; reaching it is an error",
          rcp(new Teuchos::EnhancedNumberValidator<int>(1, 1000000)));
-  // Default MUELU, by measurement (perf/README.md: per Newton iteration on
-  // the 1e5-DOF blocks of bench_newton, 1 thread, 3 steps: 2D 0.92 s against
-  // Chebyshev's 4.73 s, 3D 2.69 s against 3.12 s).
+  // Default RELAXATION, by measurement (perf/README.md): MUELU is 5x faster
+  // on FEM-only blocks (1e5 DOFs, 2D), but MPM scenes change the graph every
+  // step and pay a new hierarchy each time (A1 ci rings: linear solve 44 s
+  // with MUELU against 5.7 s with RELAXATION; A7 ci: 11.9 s against 11.7 s).
   Teuchos::setStringToIntegralParameter<int>(
-      "preconditioner", "MUELU",
-      "MUELU (algebraic multigrid on the rigid-body modes of the nodes; the measured fastest), "
-      "an Ifpack2 preconditioner (RELAXATION, CHEBYSHEV, RILUK, SCHWARZ) or NONE",
+      "preconditioner", "RELAXATION",
+      "an Ifpack2 preconditioner (RELAXATION, CHEBYSHEV, RILUK, SCHWARZ), MUELU (algebraic "
+      "multigrid on the rigid-body modes of the nodes: the fastest for FEM-only scenes, slow "
+      "where the graph changes every step, as with MPM bodies) or NONE",
       Teuchos::tuple<std::string>(kPrecNames[0], kPrecNames[1], kPrecNames[2], kPrecNames[3],
                                   kPrecNames[4], kPrecNames[5]),
       &cg);
