@@ -90,8 +90,6 @@ Teuchos::ParameterList cg_list(const std::string& prec) {
   ls.sublist("CG").set("preconditioner", prec);
   ls.sublist("CG").set("tolerance", 1e-12);
   if (prec == "RELAXATION") ls.sublist("CG").sublist("Ifpack2").set("relaxation: type", std::string("Symmetric Gauss-Seidel"));
-  if (prec == "MUELU" && std::getenv("MUELU_VERB"))
-    ls.sublist("CG").sublist("MueLu").set("verbosity", std::string(std::getenv("MUELU_VERB")));
   return ls;
 }
 

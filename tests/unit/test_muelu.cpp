@@ -73,7 +73,6 @@ std::vector<double> squash(const std::string& solver, const std::string& prec, i
     // A small coarse size, so that these small blocks get a real multilevel
     // hierarchy (by default they would be one level: a direct solve).
     setup.linear_solver.sublist("CG").sublist("MueLu").set("coarse: max size", 60);
-    if (getenv("MUELU_VERB")) setup.linear_solver.sublist("CG").sublist("MueLu").set("verbosity", std::string(getenv("MUELU_VERB")));
   }
   Simulation<dim> sim(setup, fixtures::comm());
   int its = 0;
