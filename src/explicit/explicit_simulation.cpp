@@ -3,6 +3,7 @@
 #include "explicit/explicit_simulation.hpp"
 
 #include <Kokkos_Timer.hpp>
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 #include <stdexcept>
@@ -870,6 +871,51 @@ template <int dim>
 const xmpm::XParticles<dim>& ExplicitSimulation<dim>::particles() const { return impl_->p; }
 template <int dim>
 const GridSpec<dim>& ExplicitSimulation<dim>::grid() const { return impl_->g; }
+
+template <int dim>
+ExplicitState ExplicitSimulation<dim>::state() const {
+  const auto& p = impl_->p;
+  auto x = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), p.x);
+  auto v = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), p.v);
+  auto F = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), p.F);
+  ExplicitState s;
+  s.time = impl_->time;
+  s.step = impl_->step;
+  s.over_limit = impl_->over_limit;
+  s.x.assign(x.data(), x.data() + x.size());
+  s.v.assign(v.data(), v.data() + v.size());
+  s.F.assign(F.data(), F.data() + F.size());
+  return s;
+}
+
+template <int dim>
+void ExplicitSimulation<dim>::restore(const ExplicitState& s) {
+  auto& p = impl_->p;
+  const std::size_t np = p.size();
+  auto check = [&](const std::vector<double>& a, std::size_t per, const char* name) {
+    if (a.size() != np * per)
+      throw std::invalid_argument(std::string("restart: explicit state '") + name + "' holds " +
+                                  std::to_string(a.size()) + " values; expected " + std::to_string(np * per) + " (" +
+                                  std::to_string(np) + " particles)");
+  };
+  check(s.x, dim, "particle_x");
+  check(s.v, dim, "particle_v");
+  check(s.F, dim * dim, "particle_F");
+  auto x = Kokkos::create_mirror_view(p.x);
+  auto v = Kokkos::create_mirror_view(p.v);
+  auto F = Kokkos::create_mirror_view(p.F);
+  std::copy(s.x.begin(), s.x.end(), x.data());
+  std::copy(s.v.begin(), s.v.end(), v.data());
+  std::copy(s.F.begin(), s.F.end(), F.data());
+  Kokkos::deep_copy(p.x, x);
+  Kokkos::deep_copy(p.v, v);
+  Kokkos::deep_copy(p.F, F);
+  impl_->time = s.time;
+  impl_->step = s.step;
+  impl_->over_limit = s.over_limit;
+  impl_->update_stress_only();
+  impl_->check_inside("at the restart");
+}
 
 template class ExplicitSimulation<2>;
 template class ExplicitSimulation<3>;

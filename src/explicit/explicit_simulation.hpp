@@ -24,11 +24,24 @@
 // Threading: Kokkos OpenMP; per-thread duplicated scatter (deterministic for
 // a fixed thread count); no allocation per step.
 #include <memory>
+#include <vector>
 
 #include "explicit/explicit_setup.hpp"
 #include "kernels/explicit/fields.hpp"
 
 namespace bfemp {
+
+// What a restart needs to continue bit for bit (host copies, row-major):
+// particle positions x and velocities v (np x dim, m and m/s), deformation
+// gradients F (np x dim x dim); the stress is recomputed from F, the particle
+// size from the scene. Time (s), step count and the fixed-dt steps that
+// exceeded the CFL limit.
+struct ExplicitState {
+  double time = 0;
+  long step = 0;
+  long over_limit = 0;
+  std::vector<double> x, v, F;
+};
 
 template <int dim>
 class ExplicitSimulation {
@@ -53,6 +66,12 @@ class ExplicitSimulation {
   const ExplicitSetup<dim>& setup() const;
   const xmpm::XParticles<dim>& particles() const;
   const GridSpec<dim>& grid() const;
+
+  ExplicitState state() const;
+  // Continues from `s` (a state of a simulation built from the same scene).
+  // Throws std::invalid_argument naming the array when a size differs from
+  // this simulation's particle count.
+  void restore(const ExplicitState& s);
 
   struct Impl;  // implementation detail (explicit_simulation.cpp), public for its kernels
 

@@ -27,6 +27,7 @@ namespace {
 using scene_msg::bad;
 using scene_msg::list;
 using scene_msg::num;
+using scene_msg::trim;
 
 // Rethrows a sampling or meshing error ("sampling field 'outer_radius' = 0:
 // expected ...") under the scene key it came from ("scene key 'MPM
@@ -67,11 +68,6 @@ Scene finish(ParameterList raw, const std::string& path, const std::string& base
   s.base_dir = base_dir;
   s.params = raw;
   return s;
-}
-
-std::string trim(const std::string& t) {
-  const auto a = t.find_first_not_of(' '), b = t.find_last_not_of(' ');
-  return a == std::string::npos ? "" : t.substr(a, b - a + 1);
 }
 
 int index_of(const ParameterList& list, const std::string& name) {
@@ -415,9 +411,26 @@ std::string scene_summary(const Scene& scene) {
   const auto& p = scene.params;
   std::ostringstream s;
   const auto& t = p.sublist("Time");
-  s << "scene " << (scene.path.empty() ? "(string)" : scene.path) << ": " << p.get<int>("dimension")
-    << "D, " << t.get<std::string>("integrator") << ", dt " << t.get<double>("dt") << " s to "
-    << t.get<double>("end time") << " s, eps_d " << p.sublist("Newton").get<double>("eps_d") << " m/s\n";
+  const bool ex = is_explicit(scene);
+  s << "scene " << (scene.path.empty() ? "(string)" : scene.path) << ": " << p.get<int>("dimension") << "D, ";
+  if (ex) {
+    const auto& e = p.sublist("Explicit");
+    const std::string up = e.get<std::string>("update");
+    s << "explicit multimaterial MPM, " << e.get<std::string>("shape functions") << ", "
+      << (up == "XPIC" ? "XPIC(" + std::to_string(e.get<int>("XPIC order")) + ") " + e.get<std::string>("XPIC correction")
+                       : up)
+      << ", normals " << e.get<std::string>("normals");
+    if (e.get<std::string>("normals") == "AG") s << " (" << e.get<std::string>("separation") << ")";
+    s << ", " << e.get<int>("contact passes") << " contact pass(es), law " << e.get<std::string>("law");
+    if (e.get<std::string>("law") == "coulomb") s << " mu " << e.get<double>("mu");
+    s << " (" << e.sublist("Contact Pairs").numParams() << " pair override(s)), ";
+    if (e.get<bool>("fixed dt")) s << "dt " << t.get<double>("dt") << " s (fixed)";
+    else s << "dt from CFL " << t.get<double>("CFL");
+    s << " to " << t.get<double>("end time") << " s\n";
+  } else {
+    s << t.get<std::string>("integrator") << ", dt " << t.get<double>("dt") << " s to " << t.get<double>("end time")
+      << " s, eps_d " << p.sublist("Newton").get<double>("eps_d") << " m/s\n";
+  }
   const auto& bodies = p.sublist("FEM Bodies");
   for (auto it = bodies.begin(); it != bodies.end(); ++it) {
     const auto& b = bodies.sublist(bodies.name(it));
@@ -433,15 +446,16 @@ std::string scene_summary(const Scene& scene) {
   for (auto it = mpm.begin(); it != mpm.end(); ++it) {
     const auto& b = mpm.sublist(mpm.name(it));
     const auto& m = p.sublist("Materials").sublist(b.get<std::string>("material"));
-    s << "  MPM body '" << mpm.name(it) << "': " << b.get<std::string>("shape") << ", "
-      << m.get<std::string>("model") << " E " << m.get<double>("E") << " nu " << m.get<double>("nu") << " rho "
-      << m.get<double>("density") << "\n";
+    s << "  MPM body '" << mpm.name(it) << "': " << b.get<std::string>("shape") << ", " << m.get<std::string>("model");
+    if (m.get<std::string>("model") == "hyperelastic-kg") s << " K " << m.get<double>("K") << " G " << m.get<double>("G");
+    else s << " E " << m.get<double>("E") << " nu " << m.get<double>("nu");
+    s << " rho " << m.get<double>("density") << "\n";
   }
   if (mpm.numParams() > 0)
     s << "  MPM grid dx " << p.sublist("MPM").get<double>("grid spacing") << ", "
       << p.sublist("MPM").get<int>("particles per cell") << " particles per cell, "
-      << p.sublist("MPM").get<std::string>("transfer") << ", " << p.sublist("Level Sets").numParams()
-      << " level set(s)\n";
+      << (ex ? std::string() : p.sublist("MPM").get<std::string>("transfer") + ", ")
+      << p.sublist("Level Sets").numParams() << " level set(s)\n";
   const auto& c = p.sublist("Contact");
   if (mpm.numParams() > 0 && bodies.numParams() > 0 && c.get<bool>("enabled"))
     s << "  contact: barrier dhat " << c.get<double>("dhat") << " m, kappa " << c.get<double>("kappa")

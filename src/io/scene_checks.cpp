@@ -19,6 +19,7 @@ namespace {
 using scene_msg::bad;
 using scene_msg::list;
 using scene_msg::num;
+using scene_msg::trim;
 
 void positive(const ParameterList& l, const std::string& path, const std::string& key, const std::string& what) {
   const double v = l.get<double>(key);
@@ -28,11 +29,6 @@ void positive(const ParameterList& l, const std::string& path, const std::string
 void at_least(const ParameterList& l, const std::string& path, const std::string& key, int lo) {
   const int v = l.get<int>(key);
   if (v < lo) bad(path + key, std::to_string(v), ">= " + std::to_string(lo));
-}
-
-std::string trim(const std::string& t) {
-  const auto a = t.find_first_not_of(' '), b = t.find_last_not_of(' ');
-  return a == std::string::npos ? "" : t.substr(a, b - a + 1);
 }
 
 void check_time(const ParameterList& raw) {

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <string>
+#include <vector>
 
 #include "io/scene_messages.hpp"
 
@@ -10,6 +12,81 @@ namespace bfemp {
 using Teuchos::ParameterList;
 using scene_msg::bad;
 using scene_msg::num;
+using scene_msg::trim;
+
+namespace {
+
+// The materials used by MPM bodies (the classes), in Materials order.
+std::vector<std::string> class_materials(const ParameterList& p) {
+  const auto& mats = p.sublist("Materials");
+  const auto& bodies = p.sublist("MPM Bodies");
+  std::vector<std::string> out;
+  for (auto it = mats.begin(); it != mats.end(); ++it)
+    for (auto b = bodies.begin(); b != bodies.end(); ++b) {
+      if (!bodies.entry(b).isList()) continue;
+      const ParameterList& body = bodies.sublist(bodies.name(b));
+      if (body.isType<std::string>("material") && body.get<std::string>("material") == mats.name(it)) {
+        out.push_back(mats.name(it));
+        break;
+      }
+    }
+  return out;
+}
+
+xmpm::ContactLaw law_of(const std::string& name) {
+  return name == "stick" ? xmpm::ContactLaw::Stick
+         : name == "frictionless" ? xmpm::ContactLaw::Frictionless
+                                  : xmpm::ContactLaw::Coulomb;
+}
+
+// One entry of Explicit/Contact Pairs: its key '<material> : <material>'
+// as two class indices, its value 'frictionless', 'stick' or 'coulomb <mu>'.
+struct PairLaw {
+  int a = -1, b = -1;
+  xmpm::LawParams law;
+};
+
+PairLaw parse_pair(const ParameterList& pairs, ParameterList::ConstIterator it, const std::vector<std::string>& classes) {
+  const std::string name = pairs.name(it), key = "Explicit/Contact Pairs/" + name;
+  const auto colon = name.find(':');
+  auto index = [&](const std::string& m) {
+    const auto f = std::find(classes.begin(), classes.end(), trim(m));
+    return f == classes.end() ? -1 : static_cast<int>(f - classes.begin());
+  };
+  PairLaw r;
+  if (colon != std::string::npos) {
+    r.a = index(name.substr(0, colon));
+    r.b = index(name.substr(colon + 1));
+  }
+  if (r.a < 0 || r.b < 0 || r.a == r.b)
+    bad(key, "'" + name + "'",
+        "a key '<material> : <material>' naming two different materials used by MPM bodies");
+  const auto& e = pairs.entry(it);
+  const std::string text = e.isType<std::string>() ? trim(Teuchos::getValue<std::string>(e)) : std::string();
+  const std::string what = "'frictionless', 'stick' or 'coulomb <mu>' with mu >= 0";
+  if (text.empty()) bad(key, e.isList() ? "(a sublist)" : Teuchos::toString(e.getAny()), what);
+  const auto sp = text.find(' ');
+  const std::string word = text.substr(0, sp);
+  const std::string rest = sp == std::string::npos ? "" : trim(text.substr(sp + 1));
+  if (word == "frictionless" || word == "stick") {
+    if (!rest.empty()) bad(key, "'" + text + "'", what + " (no mu after '" + word + "')");
+    r.law = {law_of(word), 0.0};
+    return r;
+  }
+  if (word != "coulomb" || rest.empty()) bad(key, "'" + text + "'", what);
+  std::size_t used = 0;
+  double mu = -1;
+  try {
+    mu = std::stod(rest, &used);
+  } catch (const std::exception&) {
+    used = 0;
+  }
+  if (used != rest.size() || !(mu >= 0) || !std::isfinite(mu)) bad(key, "'" + text + "'", what);
+  r.law = {xmpm::ContactLaw::Coulomb, mu};
+  return r;
+}
+
+}  // namespace
 
 void check_solver_keys(ParameterList& raw) {
   const bool ex = raw.isParameter("Solver") && raw.isType<std::string>("Solver") &&
@@ -65,6 +142,18 @@ void check_explicit_values(const ParameterList& p) {
   if (!sb.empty() && !p.sublist("MPM Bodies").isSublist(sb))
     bad("Explicit/stress body", "'" + sb + "'", "the name of an MPM body");
   if (p.sublist("MPM Bodies").numParams() == 0) bad("MPM Bodies", "{}", "at least one MPM body in an explicit scene");
+  {  // per-pair laws: each names two classes, each unordered pair once
+    const auto classes = class_materials(p);
+    const auto& pairs = e.sublist("Contact Pairs");
+    std::vector<int> seen(classes.size() * classes.size(), 0);
+    for (auto it = pairs.begin(); it != pairs.end(); ++it) {
+      const PairLaw r = parse_pair(pairs, it, classes);
+      const std::size_t lo = std::min(r.a, r.b), hi = std::max(r.a, r.b);
+      if (seen[lo * classes.size() + hi]++)
+        bad("Explicit/Contact Pairs/" + pairs.name(it), "(given)",
+            "each pair of materials once ('" + classes[lo] + " : " + classes[hi] + "' is given twice)");
+    }
+  }
   const auto& mats = p.sublist("Materials");
   for (auto it = mats.begin(); it != mats.end(); ++it) {
     const auto& mt = mats.sublist(mats.name(it));
@@ -131,13 +220,13 @@ ExplicitSetup<dim> build_explicit_setup(const Scene& scene) {
   s.normals = e.get<std::string>("normals") == "LR" ? XNormals::LR : XNormals::AG;
   s.separation = e.get<std::string>("separation") == "CP" ? XSeparation::CP : XSeparation::Velocity;
   s.cp_delta = e.get<double>("CP");
-  const std::string law = e.get<std::string>("law");
-  const xmpm::LawParams lp{law == "stick"          ? xmpm::ContactLaw::Stick
-                           : law == "frictionless" ? xmpm::ContactLaw::Frictionless
-                                                   : xmpm::ContactLaw::Coulomb,
-                           e.get<double>("mu")};
   const int M = static_cast<int>(s.materials.size());
-  s.laws.assign(M * M, lp);
+  s.laws.assign(M * M, xmpm::LawParams{law_of(e.get<std::string>("law")), e.get<double>("mu")});
+  const auto& pairs = e.sublist("Contact Pairs");
+  for (auto it = pairs.begin(); it != pairs.end(); ++it) {
+    const PairLaw r = parse_pair(pairs, it, s.class_names);
+    s.laws[r.a * M + r.b] = s.laws[r.b * M + r.a] = r.law;
+  }
   s.cfl = p.sublist("Time").get<double>("CFL");
   s.fixed_dt = e.get<bool>("fixed dt") ? p.sublist("Time").get<double>("dt") : 0.0;
   const std::string sb = e.get<std::string>("stress body");

@@ -24,4 +24,10 @@ inline std::string list(const Teuchos::Array<double>& a) {
   return s + "]";
 }
 
+// `t` without leading and trailing spaces.
+inline std::string trim(const std::string& t) {
+  const auto a = t.find_first_not_of(' '), b = t.find_last_not_of(' ');
+  return a == std::string::npos ? "" : t.substr(a, b - a + 1);
+}
+
 }  // namespace bfemp::scene_msg

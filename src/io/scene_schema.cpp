@@ -193,6 +193,10 @@ Teuchos::RCP<const ParameterList> scene_schema() {
   choice(ex, "law", "coulomb", "contact law of every pair of material classes (Eqs. 7-10)",
          tuple<std::string>("frictionless", "coulomb", "stick"));
   ex.set("mu", 0.0, "Coulomb friction coefficient, >= 0");
+  ex.sublist("Contact Pairs", false,
+             "per pair of material classes, overriding law and mu: keys '<material> : <material>', values "
+             "'frictionless', 'stick' or 'coulomb <mu>'")
+      .disableRecursiveValidation();
   ex.set("stress body", std::string(""), "MPM body whose mean axial stress goes to diagnostics.csv (default: all)");
   ex.set("stress axis", -1, "axis of that stress (0..dim-1; -1: the last axis)");
   ex.set("fixed dt", false,

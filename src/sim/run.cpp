@@ -6,6 +6,7 @@
 #include <cmath>
 #include <filesystem>
 #include <iomanip>
+#include <map>
 #include <ostream>
 #include <sstream>
 
@@ -35,6 +36,20 @@ std::vector<std::string> split_lines(const std::string& s) {
   return out;
 }
 
+// The texts every checkpoint stores: the scene as read, its overrides, the
+// resolved scene and the base directory (a restart rebuilds the scene from them).
+std::map<std::string, std::string> checkpoint_texts(const Scene& scene, const RunOptions& opt) {
+  std::map<std::string, std::string> t;
+  std::ostringstream resolved;
+  resolved << std::showpoint << std::setprecision(17);
+  Teuchos::writeParameterListToYamlOStream(scene.params, resolved);
+  t["scene_resolved"] = resolved.str();
+  t["scene_source"] = opt.scene_source.empty() ? resolved.str() : opt.scene_source;
+  t["overrides"] = opt.scene_source.empty() ? std::string() : join_lines(opt.overrides);
+  t["base_dir"] = std::filesystem::absolute(scene.base_dir.empty() ? "." : scene.base_dir).string();
+  return t;
+}
+
 template <int dim>
 Checkpoint make_checkpoint(const Scene& scene, const RunOptions& opt, const Simulation<dim>& sim, int frames) {
   const SimulationState<dim> st = sim.state();
@@ -43,13 +58,7 @@ Checkpoint make_checkpoint(const Scene& scene, const RunOptions& opt, const Simu
   c.step = st.step;
   c.frames = frames;
   c.dim = dim;
-  std::ostringstream resolved;
-  resolved << std::showpoint << std::setprecision(17);
-  Teuchos::writeParameterListToYamlOStream(scene.params, resolved);
-  c.texts["scene_resolved"] = resolved.str();
-  c.texts["scene_source"] = opt.scene_source.empty() ? resolved.str() : opt.scene_source;
-  c.texts["overrides"] = opt.scene_source.empty() ? std::string() : join_lines(opt.overrides);
-  c.texts["base_dir"] = std::filesystem::absolute(scene.base_dir.empty() ? "." : scene.base_dir).string();
+  c.texts = checkpoint_texts(scene, opt);
   {  // the rest mesh, so that a restart refuses a mesh file changed since
     auto X0 = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), sim.mesh().rest_position);
     auto cells = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), sim.mesh().elements.nodes);
@@ -282,12 +291,24 @@ std::vector<std::string> checkpoint_overrides(const Checkpoint& c, const std::ve
 
 RunSummary run_scene(const Scene& scene, const std::string& dir, const Teuchos::RCP<const Comm>& comm,
                      std::ostream& log, const RunOptions& options) {
+  if (options.restart && is_explicit_checkpoint(*options.restart) != is_explicit(scene))
+    throw std::invalid_argument(std::string("restart: the checkpoint was written by the ") +
+                                (is_explicit(scene) ? "implicit" : "explicit") + " stepper, the scene is " +
+                                (is_explicit(scene) ? "explicit" : "implicit"));
   if (is_explicit(scene)) {  // the explicit stepper: no Newton solver, Tpetra matrix or contact hash
-    if (options.restart) throw std::invalid_argument("restart: explicit scenes (Solver: explicit) have no restart yet");
-    const ExplicitRunSummary e = run_explicit_scene(scene, dir, log);
+    if (comm->getSize() > 1)
+      throw std::invalid_argument("scene key 'Solver' = 'explicit': the explicit stepper runs on 1 MPI rank (this run has " +
+                                  std::to_string(comm->getSize()) + "); run it without mpirun");
+    ExplicitRunOptions eo;
+    eo.checkpoint_texts = checkpoint_texts(scene, options);
+    eo.restart = options.restart;
+    eo.append = options.append;
+    eo.handle_signals = options.handle_signals;
+    const ExplicitRunSummary e = run_explicit_scene(scene, dir, log, eo);
     RunSummary s;
     s.steps = e.steps;
     s.frames = e.frames;
+    s.checkpoints = e.checkpoints;
     s.wall_s = e.wall_s;
     return s;
   }

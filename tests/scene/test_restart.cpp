@@ -9,7 +9,10 @@
 //  - SIGKILL mid-run: every frame the XDMF lists is readable with the sizes
 //    it states, and the restart from the last periodic checkpoint drops the
 //    later frames and rows and still equals the uninterrupted run;
-//  - restart --set of a key that changes the state is refused (exit 2).
+//  - restart --set of a key that changes the state is refused (exit 2);
+//  - the explicit stepper (Solver: explicit, B1 blocks in contact under the
+//    piston, LR normals, XPIC(5)): the same bit-for-bit continuation, and
+//    SIGTERM mid-run; its frames are listed in bfemp.xdmf.
 #include <gtest/gtest.h>
 #include <signal.h>
 #include <spawn.h>
@@ -350,6 +353,52 @@ TEST(Restart, SigkillLeavesReadableFramesAndRestartsFromTheLastCheckpoint) {
   expect_same_diagnostics(ref, dir);  // rows after the checkpoint were dropped, then rewritten
   // frames: one per step, 0 .. step, no duplicate left from before the kill
   EXPECT_EQ(bfemp::read_checkpoint(dir + "/checkpoint.h5").frames, ck.step + 3 + 1);
+}
+
+// The explicit stepper on the B1 blocks (in contact from step 1), XPIC(5) so
+// that the v* task and the stored pass-1 Delta v cross the restart; a fixed dt
+// below the CFL limit (1.29e-6 s) so that the step count sets the end time.
+const std::string b1 = src + "/inputs/b1_compress.yaml";
+const std::string explicit_sets =
+    "--set 'Time/dt=1e-6' --set 'Explicit/update=XPIC' --set 'Output/frame every=7' --set 'Output/progress every=0'";
+
+TEST(Restart, ExplicitSceneContinuesBitForBit) {
+  restart_equals_uninterrupted({"explicit", b1, explicit_sets, 1e-6, 25});
+  const auto rows = csv(dir_of("explicit_full") + "/diagnostics.csv");
+  ASSERT_EQ(rows[0][4], "contact_nodes");
+  for (std::size_t i = 1; i < rows.size(); ++i) EXPECT_GT(std::stol(rows[i][4]), 0) << "step " << rows[i][0];
+  // Every frame is in the XDMF index: 0, 7, 14, 21, 28, 35, 42, 49, 50 (the
+  // restarted directory also keeps step 25, the last frame of its first run).
+  const std::string xdmf = slurp(dir_of("explicit_full") + "/bfemp.xdmf");
+  std::size_t times = 0;
+  for (std::size_t at = xdmf.find("<Time "); at != std::string::npos; at = xdmf.find("<Time ", at + 1)) ++times;
+  EXPECT_EQ(times, 9u) << xdmf;
+  EXPECT_NE(xdmf.find("particle_material_class"), std::string::npos);
+}
+
+TEST(Restart, ExplicitSigtermWritesACheckpointAndExits143) {
+  const std::string dir = fresh("explicit_sigterm");
+  const pid_t pid = spawn({exe, "run", b1, "--set", "Time/dt=1e-6", "--set", "Explicit/update=XPIC", "--set",
+                           "Output/frame every=7", "--set", "Output/progress every=0", "--set", "Time/end time=1.0",
+                           "-o", dir},
+                          dir + ".log");
+  ASSERT_TRUE(wait_rows(pid, dir, 12));
+  kill(pid, SIGTERM);
+  EXPECT_EQ(wait_exit(pid), 143) << slurp(dir + ".log");
+  EXPECT_NE(slurp(dir + ".log").find("continue with: bfemp restart " + dir), std::string::npos) << slurp(dir + ".log");
+  const bfemp::Checkpoint ck = bfemp::read_checkpoint(dir + "/checkpoint.h5");
+  EXPECT_GE(ck.step, 12);
+  char name[32];
+  std::snprintf(name, sizeof name, "/frame_%06d", ck.frames - 1);
+  EXPECT_EQ(bfemp::read_attribute(dir + "/bfemp.h5", name, "step"), ck.step);
+  const Case c{"explicit_sigterm", b1, explicit_sets, 1e-6, 0};
+  const std::string ref = fresh("explicit_sigterm_ref");
+  const std::string end = end_time(c, ck.step + 5);
+  ASSERT_EQ(run_bfemp("run " + b1 + " " + explicit_sets + " " + end + " -o " + ref, ref + ".log"), 0)
+      << slurp(ref + ".log");
+  ASSERT_EQ(run_bfemp("restart " + dir + " " + end, dir + ".restart.log"), 0) << slurp(dir + ".restart.log");
+  expect_same_checkpoint(ref, dir);
+  expect_same_diagnostics(ref, dir);
 }
 
 TEST(Restart, SetOfAShapeChangingKeyIsRefused) {
