@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # The bfemp executable on 1 and 2 MPI ranks (label mpi): the squash scene
 # (FEM only, CG) gives the same frames and diagnostics on both; on 2 ranks a
-# direct solver and an MPM scene are refused before the first step (exit 2,
+# direct solver, an MPM scene and an explicit scene are refused before the first step (exit 2,
 # a message naming the key). Usage: run_np2.sh BFEMP SOURCE_DIR WORK_DIR
 set -euo pipefail
 exe=$1; src=$2; work=$3
@@ -50,4 +50,9 @@ set +e
 "${mpi[@]}" -np 2 "$exe" run "$src/inputs/mpm_column.yaml" --output "$work/mpm" --set 'Linear Solver/type=CG' > "$work/mpm.log" 2>&1; rc=$?
 set -e
 [ $rc = 2 ] && grep -q "MPM" "$work/mpm.log" || { echo "MPM scene on 2 ranks: exit $rc"; cat "$work/mpm.log"; exit 1; }
-echo "refusals on 2 ranks: direct solver, MPM scene (exit 2)"
+set +e
+"${mpi[@]}" -np 2 "$exe" run "$src/inputs/b1_contact.yaml" --output "$work/explicit" > "$work/explicit.log" 2>&1; rc=$?
+set -e
+[ $rc = 2 ] && grep -q "'Solver' = 'explicit'" "$work/explicit.log" || { echo "explicit scene on 2 ranks: exit $rc"; cat "$work/explicit.log"; exit 1; }
+[ ! -e "$work/explicit/bfemp.h5" ] || { echo "the refused explicit run wrote output"; exit 1; }
+echo "refusals on 2 ranks: direct solver, MPM scene, explicit scene (exit 2)"
