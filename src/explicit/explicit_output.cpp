@@ -73,13 +73,7 @@ ExplicitOutput<dim>::ExplicitOutput(const std::string& dir, const Scene& scene, 
 
 template <int dim>
 XdmfFrame ExplicitOutput<dim>::xdmf_frame(int index, double time) const {
-  XdmfGrid g;
-  g.name = "particles";
-  g.group = Hdf5FrameWriter::frame_group_name(index);
-  g.topology = {"Polyvertex", np_, 1, "/mesh/particle_vertices"};
-  g.num_nodes = np_;
-  g.dim = dim;
-  g.geometry = "particle_positions";
+  XdmfGrid g = xdmf_particle_grid(index, np_, dim);
   g.node_attributes = {{"velocity", "particle_velocities", dim},
                        {"stress", "particle_stress", 9},
                        {"von_mises", "particle_von_mises", 1},
@@ -123,7 +117,7 @@ void ExplicitOutput<dim>::write_frame(const ExplicitSimulation<dim>& sim) {
         dev2 += sd * sd;
       }
     vm[q] = std::sqrt(1.5 * dev2);
-    pr[q] = -tr / dim;
+    pr[q] = 0.0 - tr / dim;  // (0 - 0 = +0: no -0 in the file)
     J[q] = Fq.determinant();
     bs[q] = b(q);
     cs[q] = c(q);

@@ -2,12 +2,10 @@
 
 #include <Kokkos_Timer.hpp>
 #include <cmath>
-#include <csignal>
 #include <filesystem>
 #include <iomanip>
 #include <memory>
 #include <ostream>
-#include <sstream>
 #include <vector>
 
 #include "explicit/explicit_output.hpp"
@@ -121,17 +119,7 @@ ExplicitRunSummary run_dim(const Scene& scene, const std::string& dir, std::ostr
           << "  contact nodes " << r.contact_nodes << "  stress " << r.stress_body << " Pa  wall " << wall.seconds()
           << " s\n"
           << std::flush;
-    if (sig) {
-      try {
-        out.close();
-      } catch (const std::exception& e) {
-        log << "warning: closing the output after the signal failed: " << e.what() << "\n";
-      }
-      std::ostringstream msg;
-      msg << (sig == SIGINT ? "SIGINT" : sig == SIGTERM ? "SIGTERM" : "signal") << " after step " << r.step
-          << " (t = " << r.time << " s): frame and checkpoint written; continue with: bfemp restart " << dir;
-      throw Interrupted(sig, msg.str());
-    }
+    if (sig) stop_after_signal(sig, r.step, r.time, dir, log, [&] { out.close(); });
   }
   checkpoint();
   out.close();

@@ -104,14 +104,7 @@ XdmfFrame RunOutput<dim>::xdmf_frame(const Simulation<dim>& sim, int index, doub
     frame.grids.push_back(g);
   }
   if (const auto* mpm = sim.mpm()) {
-    const std::size_t np = mpm->particles().size();
-    XdmfGrid g;
-    g.name = "particles";
-    g.group = Hdf5FrameWriter::frame_group_name(index);
-    g.topology = {"Polyvertex", np, 1, "/mesh/particle_vertices"};
-    g.num_nodes = np;
-    g.dim = dim;
-    g.geometry = "particle_positions";
+    XdmfGrid g = xdmf_particle_grid(index, mpm->particles().size(), dim);
     g.node_attributes = {{"velocity", "particle_velocities", dim},
                          {"von_mises", "particle_von_mises", 1},
                          {"J", "particle_J", 1},

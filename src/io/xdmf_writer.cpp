@@ -8,8 +8,20 @@
 #include <utility>
 
 #include "io/atomic_file.hpp"
+#include "io/hdf5_frames.hpp"
 
 namespace bfemp {
+
+XdmfGrid xdmf_particle_grid(int index, std::size_t num_particles, int dim) {
+  XdmfGrid g;
+  g.name = "particles";
+  g.group = Hdf5FrameWriter::frame_group_name(index);
+  g.topology = {"Polyvertex", num_particles, 1, "/mesh/particle_vertices"};
+  g.num_nodes = num_particles;
+  g.dim = dim;
+  g.geometry = "particle_positions";
+  return g;
+}
 namespace {
 
 std::string escape(const std::string& s) {

@@ -50,6 +50,11 @@ struct XdmfFrame {
   std::vector<XdmfGrid> grids;  // at least one
 };
 
+// The particle grid of frame `index` as bfemp writes it: "particles", a
+// polyvertex over /mesh/particle_vertices, geometry particle_positions in the
+// frame's group; the caller adds the attributes.
+XdmfGrid xdmf_particle_grid(int index, std::size_t num_particles, int dim);
+
 class XdmfSeriesWriter {
  public:
   // `xdmf_path`: the file to (re)write. `h5_name`: the HDF5 file as the .xdmf

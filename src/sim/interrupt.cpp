@@ -1,5 +1,8 @@
 #include "sim/interrupt.hpp"
 
+#include <ostream>
+#include <sstream>
+
 namespace bfemp {
 
 namespace {
@@ -32,5 +35,18 @@ InterruptGuard::~InterruptGuard() {
 }
 
 int pending_signal() { return static_cast<int>(g_signal); }
+
+void stop_after_signal(int sig, long step, double time, const std::string& dir, std::ostream& log,
+                       const std::function<void()>& close) {
+  try {
+    close();
+  } catch (const std::exception& e) {
+    log << "warning: closing the output after the signal failed: " << e.what() << "\n";
+  }
+  std::ostringstream msg;
+  msg << (sig == SIGINT ? "SIGINT" : sig == SIGTERM ? "SIGTERM" : "signal") << " after step " << step
+      << " (t = " << time << " s): frame and checkpoint written; continue with: bfemp restart " << dir;
+  throw Interrupted(sig, msg.str());
+}
 
 }  // namespace bfemp

@@ -6,6 +6,8 @@
 // one is pending restores the default action (a user pressing Ctrl-C
 // twice wants out now). The previous handlers come back when the guard dies.
 #include <csignal>
+#include <functional>
+#include <iosfwd>
 #include <stdexcept>
 #include <string>
 
@@ -28,5 +30,12 @@ struct Interrupted : std::runtime_error {
   int signal;
   int exit_code() const { return 128 + signal; }  // 130 SIGINT, 143 SIGTERM
 };
+
+// The run loop's exit after a signal, once the frame and the checkpoint of
+// `step` (at `time` s) are written: calls `close` (the output files; a failure
+// is a warning on `log`), then throws Interrupted naming the signal, the step
+// and the restart command for `dir`.
+[[noreturn]] void stop_after_signal(int sig, long step, double time, const std::string& dir, std::ostream& log,
+                                    const std::function<void()>& close);
 
 }  // namespace bfemp

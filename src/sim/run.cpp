@@ -243,17 +243,10 @@ RunSummary run_dim(const Scene& scene, const std::string& dir, const Teuchos::RC
           << " s  eta " << el / done * (n_steps - n - 1) << " s\n"
           << std::flush;
     }
-    if (sig) {
-      try {
+    if (sig)
+      stop_after_signal(sig, r.step, r.time, dir, log, [&] {
         if (root) out_ptr->close();
-      } catch (const std::exception& e) {
-        log << "warning: closing the output after the signal failed: " << e.what() << "\n";
-      }
-      std::ostringstream msg;
-      msg << (sig == SIGINT ? "SIGINT" : sig == SIGTERM ? "SIGTERM" : "signal") << " after step " << r.step
-          << " (t = " << r.time << " s): frame and checkpoint written; continue with: bfemp restart " << dir;
-      throw Interrupted(sig, msg.str());
-    }
+      });
   }
   checkpoint();
   if (root) out_ptr->close();
