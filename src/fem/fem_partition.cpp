@@ -17,14 +17,22 @@ FemPartition partition_fem_mesh(const FemMesh<dim>& mesh, const Teuchos::RCP<con
   auto X = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), mesh.rest_position);
   FemPartition part;
   part.element_rank.assign(ne, 0);
-  if (nranks > 1 && ne > 0) {
+  if (nranks > 1 && ne > 0 && ne < nranks) {
+    // Fewer elements than ranks (Zoltan's RCB refuses to cut them): element e
+    // goes to rank e, the other ranks own no element.
+    for (LO e = 0; e < ne; ++e) part.element_rank[e] = static_cast<int>(e);
+  } else if (nranks > 1 && ne > 0) {
     // Each rank hands Zoltan2 a contiguous slice of the elements.
     const LO e0 = static_cast<LO>(static_cast<long long>(ne) * rank / nranks);
     const LO e1 = static_cast<LO>(static_cast<long long>(ne) * (rank + 1) / nranks);
     const LO n = e1 - e0;
-    std::vector<long long> ids(n);
+    // At least one entry each: the adapter counts the coordinates it is given
+    // by their non-null pointers, and an empty std::vector may hand out null;
+    // a rank with no elements (fewer elements than ranks) would then join
+    // RCB's reductions with another dimension (MPI_ERR_TRUNCATE).
+    std::vector<long long> ids(std::max<LO>(n, 1));
     std::vector<double> c[3];
-    for (auto& v : c) v.assign(n, 0.0);
+    for (auto& v : c) v.assign(std::max<LO>(n, 1), 0.0);
     for (LO k = 0; k < n; ++k) {
       ids[k] = e0 + k;
       for (int a = 0; a < nv; ++a)

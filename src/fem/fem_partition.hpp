@@ -4,6 +4,9 @@
 // Elements: recursive coordinate bisection (Zoltan2 "rcb") of the element
 // centroids at rest, unit weights: equal element counts per rank and compact
 // pieces, so a piece's boundary (the ghost layer) grows like its surface.
+// Fewer elements than ranks (RCB cannot cut them): element e on rank e, and
+// the other ranks own no element and no node, yet take part in every
+// collective step.
 // Nodes: a node is owned by the lowest rank holding an element that touches
 // it (a node of no element: rank 0). A rank's local nodes are its owned nodes
 // in ascending global id, then its ghosts (the other nodes of its elements)

@@ -3,8 +3,9 @@
 // replicated) equals the same scene run by each rank alone (MPI_COMM_SELF):
 // positions, velocities and energies after 6 steps of a squashed neo-Hookean
 // block with gravity, in 2D and 3D, with CG + Ifpack2 and CG + MueLu; and
-// every rank reports the same Newton iterations. MPM scenes are refused on
-// more than one rank.
+// every rank reports the same Newton iterations. A one-triangle body, so that
+// on 2 ranks one rank owns no element at all, equals the same on one rank.
+// MPM scenes are refused on more than one rank.
 #include <gtest/gtest.h>
 
 #include <Teuchos_CommHelpers.hpp>
@@ -94,6 +95,56 @@ void distributed_equals_alone(const std::string& prec) {
 TEST(SimulationMpi, FemSquash2DRelaxationEqualsOneRank) { distributed_equals_alone<2>("RELAXATION"); }
 TEST(SimulationMpi, FemSquash2DMueLuEqualsOneRank) { distributed_equals_alone<2>("MUELU"); }
 TEST(SimulationMpi, FemSquash3DMueLuEqualsOneRank) { distributed_equals_alone<3>("MUELU"); }
+
+// One triangle (0,0), (1,0), (0,1): its bottom edge fixed, its top node
+// falling under gravity. On 2 ranks RCB gives the element to one rank; the
+// other owns no element and no DOF, and must still take every collective
+// step (reductions, Export, Import) with the same result.
+Result one_triangle(const Teuchos::RCP<const Comm>& comm) {
+  SimulationSetup<2> setup = fixtures::block_setup<2>(0.5, 1e5, 0.3, 1000.0, 1.0, "CG");
+  MeshData& m = setup.bodies[0].mesh;
+  m.coords = {0.0, 0.0, 1.0, 0.0, 0.0, 1.0};
+  m.cells = {0, 1, 2};
+  m.node_sets = {{"bottom", {0, 1}}, {"top", {2}}};
+  setup.dt = 1e-2;
+  setup.gravity = {0.0, -9.81, 0.0};
+  setup.linear_solver.sublist("CG").set("tolerance", 1e-13);
+  fixtures::prescribe<2>(setup, "bottom");
+  Simulation<2> sim(setup, comm);
+  Result r;
+  for (int s = 0; s < 6; ++s) {
+    const StepReport rep = sim.step();
+    r.iterations.push_back(rep.newton.iterations);
+    r.kinetic = rep.kinetic;
+    r.elastic = rep.elastic;
+  }
+  auto x = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), sim.positions());
+  auto v = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), sim.velocities());
+  r.x.assign(x.data(), x.data() + x.extent(0));
+  r.v.assign(v.data(), v.data() + v.extent(0));
+  return r;
+}
+
+TEST(SimulationMpi, ARankWithoutElementsEqualsOneRank) {
+  auto world = Tpetra::getDefaultComm();
+  Teuchos::RCP<const Comm> self = Teuchos::rcp(new Teuchos::MpiComm<int>(MPI_COMM_SELF));
+  const Result d = one_triangle(world);
+  const Result s = one_triangle(self);
+  ASSERT_EQ(d.x.size(), 6u);
+  ASSERT_EQ(s.x.size(), 6u);
+  for (std::size_t i = 0; i < 6; ++i) {
+    EXPECT_NEAR(d.x[i], s.x[i], 1e-10) << i;
+    EXPECT_NEAR(d.v[i], s.v[i], 1e-8) << i;
+  }
+  EXPECT_LT(s.x[5], 1.0 - 1e-4) << "the top node should have fallen";
+  EXPECT_NEAR(d.elastic, s.elastic, 1e-8 * s.elastic);
+  for (int it : d.iterations) {
+    int lo = 0, hi = 0;
+    Teuchos::reduceAll(*world, Teuchos::REDUCE_MIN, it, Teuchos::outArg(lo));
+    Teuchos::reduceAll(*world, Teuchos::REDUCE_MAX, it, Teuchos::outArg(hi));
+    EXPECT_EQ(lo, hi);
+  }
+}
 
 TEST(SimulationMpi, MpmSceneRefusedOnSeveralRanks) {
   auto world = Tpetra::getDefaultComm();
