@@ -4,6 +4,7 @@
 
 #include <Kokkos_Timer.hpp>
 #include <cmath>
+#include <cstdlib>
 #include <sstream>
 #include <stdexcept>
 
@@ -651,11 +652,13 @@ struct StepKernels {
       xpic_vstar<dim, Shape>(g, M, p, s.gm, v1, dv1, m, s.bc, s.vstar, s.xpic);
     const auto vs = s.vstar;
     const auto vone = v1;
+    const auto vlump = s.v;
+    const int posmode = std::getenv("BFEMP_XPIC_POS") ? std::atoi(std::getenv("BFEMP_XPIC_POS")) : 0;  // EXPERIMENT
     Kokkos::parallel_for(
         "xmpm_g2p", Kokkos::RangePolicy<ExecSpace>(0, p.size()), KOKKOS_LAMBDA(const LO q) {
           const St st = Shape::template stencil<dim>(g, pos(p, q), p.lp(q));
           const int a = p.cls(q);
-          double Svp[dim] = {}, Sa[dim] = {}, Sv1[dim] = {}, Svs[dim] = {};
+          double Svp[dim] = {}, Sa[dim] = {}, Sv1[dim] = {}, Svs[dim] = {}, Sv[dim] = {};
           for (int k = 0; k < St::size; ++k) {
             const double w = st.weight(k);
             if (w == 0.0) continue;
@@ -663,6 +666,7 @@ struct StepKernels {
             for (int c = 0; c < dim; ++c) {
               Svp[c] += w * vp(sl + c);
               Sa[c] += w * (vp(sl + c) - v(sl + c)) / dt;
+              Sv[c] += w * vlump(sl + c);
               if (xpic) {
                 Sv1[c] += w * vone(sl + c);
                 Svs[c] += w * vs(sl + c);
@@ -676,7 +680,9 @@ struct StepKernels {
             } else {
               const double Vn = up == XUpdate::PIC ? Svp[c] : m * (Sv1[c] - Svs[c]) + dt * Sa[c];
               p.v(q, c) = Vn;
-              p.x(q, c) += dt * (Vn - 0.5 * dt * Sa[c]);
+              if (posmode == 0) p.x(q, c) += dt * (Vn - 0.5 * dt * Sa[c]);
+              else if (posmode == 1) p.x(q, c) += dt * (Sv[c] + 0.5 * dt * Sa[c]);
+              else p.x(q, c) += dt * Svp[c];
             }
           }
         });

@@ -84,6 +84,8 @@ History run(bool two, XNormals nm, XSeparation sep, XUpdate up, int passes, cons
   s.update = up;
   s.xpic_order = std::getenv("BFEMP_B1_XPIC_ORDER") ? std::atoi(std::getenv("BFEMP_B1_XPIC_ORDER")) : 5;
   s.contact_passes = passes;
+  if (std::getenv("BFEMP_B1_BSPLINE")) s.shape = XShape::QuadraticBSpline;  // EXPERIMENT
+  if (std::getenv("BFEMP_B1_PISTON_SLIP")) s.level_sets[1].slip = true;     // EXPERIMENT
   if (std::getenv("BFEMP_B1_UNCORRECTED")) s.xpic_corrected = false;
   // LR knobs for the diagnostics (defaults: the paper's d_LR < 0 and lambda = 1e-7 dx^2)
   if (std::getenv("BFEMP_B1_LR_TOL")) s.lr.contact_tolerance = std::atof(std::getenv("BFEMP_B1_LR_TOL"));
@@ -136,6 +138,7 @@ History run(bool two, XNormals nm, XSeparation sep, XUpdate up, int passes, cons
           up_x = x(q, 0);
         }
       }
+      std::printf("  KE %.4g J/m ", r.kinetic);
       std::printf("  %s e=%.3f stress %.4g ymin %.3f mm x [%.3f, %.3f] mm |v|max %.3g lower top %.3f (x %.3f) upper bottom %.3f (x %.3f) mm dt/limit %.3f active %ld; fastest %zu at (%.3f, %.3f) mm v (%.3g, %.3g)\n",
                   name.c_str(), v * r.time / H, r.stress_all, 1e3 * ymin, 1e3 * xmin, 1e3 * xmax, vmax, 1e3 * lo_top, 1e3 * lo_x,
                   1e3 * up_bot, 1e3 * up_x, r.dt / r.dt_limit, r.active_nodes, qmax, 1e3 * x(qmax, 0), 1e3 * x(qmax, 1), vv(qmax, 0), vv(qmax, 1));
