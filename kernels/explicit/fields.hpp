@@ -9,7 +9,6 @@
 // mass kg (kg/m in 2D plane strain), momentum kg m/s, velocity m/s.
 #include <Kokkos_Core.hpp>
 #include <Kokkos_ScatterView.hpp>
-#include <cstdlib>
 
 #include "core/types.hpp"
 #include "mpm/grid.hpp"
@@ -199,8 +198,7 @@ void xpic_vstar(const GridSpec<dim>& g, int M, const XParticles<dim>& p, Kokkos:
     const double sign = k % 2 == 0 ? 1.0 : -1.0;
     auto vk = s.vk, dvk = s.dvk, vk1 = s.vk1, dvk1 = s.dvk1;
     auto flag = bc.flag;
-    const bool nobc = std::getenv("BFEMP_XPIC_NOBC") != nullptr;  // EXPERIMENT
-    const bool has_bc = flag.extent(0) > 0 && !nobc;
+    const bool has_bc = flag.extent(0) > 0;
     Kokkos::parallel_for(
         "xpic_step", Kokkos::RangePolicy<ExecSpace>(0, n), KOKKOS_LAMBDA(const LO i) {
           const LO node = i / (dim * M), c = i % dim;
