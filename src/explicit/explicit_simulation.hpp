@@ -17,7 +17,10 @@
 //   7. particle update with a^alpha = (v^{alpha+} - v^alpha)/dt (Eqs. 32-34):
 //      FLIP: V += dt S a, X += dt S v^+;  PIC: V = S v^+;
 //      XPIC(m): V = m S (v^alpha - v*^alpha) + dt S a (Eqs. 41-44);
-//      PIC / XPIC positions: X += dt (V^{n+1} - dt/2 S a) (trapezoidal, as the XPIC paper).
+//      PIC / XPIC positions: X += dt (S v^{alpha+} - dt/2 S a) = dt S (v^alpha + dt/2 a),
+//      the lumped grid velocity that also updates F (step 4), not the XPIC
+//      particle velocity (a sharpened field F never sees: positions and F
+//      drift apart; single-material XPIC(5) in B1(b) blew up at 16.6 % strain).
 // Contact acts when the materials approach (Eq. 14) AND are touching
 // (d_LR < 0, or Eq. 16 for CP; the velocity-only AG method tests approach
 // alone); the stick law always acts.
