@@ -27,6 +27,23 @@ struct Result {
   double kinetic = 0, elastic = 0;
 };
 
+// Six steps: the Newton iterations of each, the final energies and state.
+template <int dim>
+Result six_steps(Simulation<dim>& sim) {
+  Result r;
+  for (int s = 0; s < 6; ++s) {
+    const StepReport rep = sim.step();
+    r.iterations.push_back(rep.newton.iterations);
+    r.kinetic = rep.kinetic;
+    r.elastic = rep.elastic;
+  }
+  auto x = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), sim.positions());
+  auto v = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), sim.velocities());
+  r.x.assign(x.data(), x.data() + x.extent(0));
+  r.v.assign(v.data(), v.data() + v.extent(0));
+  return r;
+}
+
 template <int dim>
 Result run(const Teuchos::RCP<const Comm>& comm, const std::string& prec) {
   auto setup = fixtures::block_setup<dim>(dim == 2 ? 0.08 : 0.25, 1e5, 0.35, 1000.0, 1.0, "CG");
@@ -43,18 +60,7 @@ Result run(const Teuchos::RCP<const Comm>& comm, const std::string& prec) {
   down.velocity = {0.0, -1.0, 0.0};
   fixtures::prescribe<dim>(setup, "top", {down});
   Simulation<dim> sim(setup, comm);
-  Result r;
-  for (int s = 0; s < 6; ++s) {
-    const StepReport rep = sim.step();
-    r.iterations.push_back(rep.newton.iterations);
-    r.kinetic = rep.kinetic;
-    r.elastic = rep.elastic;
-  }
-  auto x = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), sim.positions());
-  auto v = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), sim.velocities());
-  r.x.assign(x.data(), x.data() + x.extent(0));
-  r.v.assign(v.data(), v.data() + v.extent(0));
-  return r;
+  return six_steps(sim);
 }
 
 template <int dim>
@@ -111,18 +117,7 @@ Result one_triangle(const Teuchos::RCP<const Comm>& comm) {
   setup.linear_solver.sublist("CG").set("tolerance", 1e-13);
   fixtures::prescribe<2>(setup, "bottom");
   Simulation<2> sim(setup, comm);
-  Result r;
-  for (int s = 0; s < 6; ++s) {
-    const StepReport rep = sim.step();
-    r.iterations.push_back(rep.newton.iterations);
-    r.kinetic = rep.kinetic;
-    r.elastic = rep.elastic;
-  }
-  auto x = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), sim.positions());
-  auto v = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), sim.velocities());
-  r.x.assign(x.data(), x.data() + x.extent(0));
-  r.v.assign(v.data(), v.data() + v.extent(0));
-  return r;
+  return six_steps(sim);
 }
 
 TEST(SimulationMpi, ARankWithoutElementsEqualsOneRank) {
