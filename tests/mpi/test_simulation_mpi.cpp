@@ -27,6 +27,16 @@ struct Result {
   double kinetic = 0, elastic = 0;
 };
 
+// Every rank took the same Newton iterations in every step.
+void expect_same_on_every_rank(const Comm& world, const std::vector<int>& iterations) {
+  for (int it : iterations) {
+    int lo = 0, hi = 0;
+    Teuchos::reduceAll(world, Teuchos::REDUCE_MIN, it, Teuchos::outArg(lo));
+    Teuchos::reduceAll(world, Teuchos::REDUCE_MAX, it, Teuchos::outArg(hi));
+    EXPECT_EQ(lo, hi);
+  }
+}
+
 // Six steps: the Newton iterations of each, the final energies and state.
 template <int dim>
 Result six_steps(Simulation<dim>& sim) {
@@ -81,13 +91,7 @@ void distributed_equals_alone(const std::string& prec) {
   EXPECT_LT(ev, 1e-7 * vs) << dim << "D " << prec;
   EXPECT_NEAR(d.kinetic, s.kinetic, 1e-8 * s.kinetic);
   EXPECT_NEAR(d.elastic, s.elastic, 1e-8 * s.elastic);
-  // Every rank took the same Newton iterations in every step.
-  for (int it : d.iterations) {
-    int lo = 0, hi = 0;
-    Teuchos::reduceAll(*world, Teuchos::REDUCE_MIN, it, Teuchos::outArg(lo));
-    Teuchos::reduceAll(*world, Teuchos::REDUCE_MAX, it, Teuchos::outArg(hi));
-    EXPECT_EQ(lo, hi);
-  }
+  expect_same_on_every_rank(*world, d.iterations);
   if (world->getRank() == 0) {
     int total = 0;
     for (int it : d.iterations) total += it;
@@ -133,12 +137,7 @@ TEST(SimulationMpi, ARankWithoutElementsEqualsOneRank) {
   }
   EXPECT_LT(s.x[5], 1.0 - 1e-4) << "the top node should have fallen";
   EXPECT_NEAR(d.elastic, s.elastic, 1e-8 * s.elastic);
-  for (int it : d.iterations) {
-    int lo = 0, hi = 0;
-    Teuchos::reduceAll(*world, Teuchos::REDUCE_MIN, it, Teuchos::outArg(lo));
-    Teuchos::reduceAll(*world, Teuchos::REDUCE_MAX, it, Teuchos::outArg(hi));
-    EXPECT_EQ(lo, hi);
-  }
+  expect_same_on_every_rank(*world, d.iterations);
 }
 
 TEST(SimulationMpi, MpmSceneRefusedOnSeveralRanks) {
