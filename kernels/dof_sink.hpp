@@ -40,6 +40,10 @@ struct DofSink {
   Kokkos::View<const double*, typename LocalMatrix::memory_space> dx_prescribed;
   double scale = 1.0;
   bool atomic = true;
+  // false: the terms hand over their exact local Hessians, not the PSD
+  // projections (the Newton solver's exact-if-definite iterations; the
+  // factorisation then decides whether the sum is positive definite).
+  bool project = true;
   // Counts blocks the graph lacks (when allocated): the DOF space rebuilds
   // the graph and reassembles instead of dropping them.
   Kokkos::View<int, typename LocalMatrix::memory_space> dropped;

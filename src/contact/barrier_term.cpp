@@ -221,7 +221,7 @@ void BarrierTerm<dim>::gradient(ConstDofView x, double scale, DofView grad) cons
 template <int dim>
 void BarrierTerm<dim>::assemble(ConstDofView x, const Sink<dim>& sink) const {
   if (n_pairs_ == 0) return;
-  const bool project = project_;
+  const bool project = project_ && sink.project;
   for_each_pair(x, [=](LO, const PairDofs<dim>& pd, const auto& g, const auto& H) {
     constexpr int L = std::decay_t<decltype(g)>::RowsAtCompileTime;
     SquareMat<L> Hp = H;

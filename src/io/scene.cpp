@@ -400,6 +400,10 @@ SimulationSetup<dim> build_setup(const Scene& scene) {
   setup.gravity = vec3(p.get<Array<double>>("gravity"), dim, "gravity");
   setup.newton.eps_d = p.sublist("Newton").get<double>("eps_d");
   setup.newton.max_iterations = p.sublist("Newton").get<int>("max iterations");
+  setup.newton.hessian = p.sublist("Newton").get<std::string>("hessian") == "exact-if-definite"
+                             ? HessianMode::ExactIfDefinite
+                             : HessianMode::Projected;
+  setup.newton.log_iterations = p.sublist("Newton").get<bool>("log iterations");
   setup.linear_solver = p.sublist("Linear Solver");
   return setup;
 }
@@ -429,7 +433,12 @@ std::string scene_summary(const Scene& scene) {
     s << " to " << t.get<double>("end time") << " s\n";
   } else {
     s << t.get<std::string>("integrator") << ", dt " << t.get<double>("dt") << " s to " << t.get<double>("end time")
-      << " s, eps_d " << p.sublist("Newton").get<double>("eps_d") << " m/s\n";
+      << " s, eps_d " << p.sublist("Newton").get<double>("eps_d") << " m/s, "
+      << (p.sublist("Newton").get<std::string>("hessian") == "projected" ||
+                  p.sublist("Linear Solver").get<std::string>("type") != "Cholmod"
+              ? "projected Hessian"
+              : "exact Hessian where definite")
+      << "\n";
   }
   const auto& bodies = p.sublist("FEM Bodies");
   for (auto it = bodies.begin(); it != bodies.end(); ++it) {

@@ -156,6 +156,14 @@ Teuchos::RCP<const ParameterList> scene_schema() {
   auto& newton = pl->sublist("Newton", false, "projected Newton (paper Algorithm 2)");
   newton.set("eps_d", 1e-6, "stop when |p|_inf / dt < eps_d (m/s)");
   newton.set("max iterations", 200, "iteration cap per step; reaching it is an error");
+  choice(newton, "hessian", "exact-if-definite",
+         "exact-if-definite: the exact Hessian whenever Cholmod factorises it, else the projected one "
+         "(other linear solvers: always projected); projected: PSD-projected stencil Hessians (paper "
+         "Algorithm 2)",
+         tuple<std::string>("projected", "exact-if-definite"));
+  newton.set("log iterations", false,
+             "print one line per Newton iteration to stderr: |p|_inf/dt, line-search step and its CCD/inversion "
+             "bound, |rhs|, which Hessian");
   pl->set("Linear Solver", *linear_solver_schema(), "linear solver of each Newton iteration");
   auto& out = pl->sublist("Output", false, "output frames and progress");
   out.set("frame every", 10, "steps between HDF5/XDMF frames (frame 0 is the initial state)");

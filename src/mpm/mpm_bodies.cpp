@@ -25,7 +25,7 @@ void MpmElasticityTerm<dim>::assemble(ConstDofView x, const Sink<dim>& sink) con
   constexpr int nd = ns * dim;
   constexpr int nc = ParticleCells<dim>::n_colors;
   const auto s = this->stencils();
-  const bool project = this->projection();
+  const bool project = this->projection() && sink.project;
   const auto cells = cells_.cells;
   const auto start = cells_.start;
   const auto count = cells_.count;

@@ -147,6 +147,8 @@ void accumulate(RunSummary& s, const StepReport& r) {
   s.contact_eval_s += r.contact_eval_s;
   s.contact_ccd_s += r.contact_ccd_s;
   s.symbolic_factorizations += r.newton.symbolic_factorizations;
+  s.exact_hessian_iterations += r.newton.exact_hessian_iterations;
+  s.projection_fallbacks += r.newton.projection_fallbacks;
 }
 
 // The signal any rank received (every rank stops after the same step).
@@ -319,7 +321,11 @@ RunSummary run_scene(const Scene& scene, const std::string& dir, const Teuchos::
         << std::setprecision(3) << (s.assembly_s > 0 ? 100.0 * sec / s.assembly_s : 0.0) << " %)\n";
   log << "  graph builds        " << s.graph_builds << " (symbolic factorisations " << s.symbolic_factorizations
       << ")\n"
-      << "  linear-solve time   " << s.solve_s << " s\n"
+      << "  linear-solve time   " << s.solve_s << " s\n";
+  if (s.exact_hessian_iterations + s.projection_fallbacks > 0)
+    log << "  exact Hessian       " << s.exact_hessian_iterations << " of " << s.newton_iterations
+        << " iterations (" << s.projection_fallbacks << " not positive definite: projected)\n";
+  log
       << "  line-search time    " << s.line_search_s << " s\n";
   if (s.contact)
     log << "  contact: broad phase " << s.contact_broad_phase_s << " s, pair evaluation " << s.contact_eval_s

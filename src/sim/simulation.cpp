@@ -451,6 +451,8 @@ NewtonStats Simulation<dim>::minimize_with_friction(const IncrementalPotential& 
     total.min_step = std::min(total.min_step, st.min_step);
     total.graph_builds += st.graph_builds;
     total.symbolic_factorizations += st.symbolic_factorizations;
+    total.exact_hessian_iterations += st.exact_hessian_iterations;
+    total.projection_fallbacks += st.projection_fallbacks;
     if (iterations > 1 && st.iterations == 1) break;  // converged at the lagged update
     const LO relagged = contact_->update_friction(x, x_ref, s, ip.dt);
     if (lagged == 0 && relagged == 0) break;  // no friction pairs before or after

@@ -97,8 +97,11 @@ bool CholmodDirect::solve(const Vector& b, Vector& x) {
     m.analysed = true;
     analysed_now = true;
   }
-  if (!cholmod_l_factorize(&S, m.L, &m.c) || m.c.status != CHOLMOD_OK)
+  if (!cholmod_l_factorize(&S, m.L, &m.c) || m.c.status != CHOLMOD_OK) {
+    if (m.c.status == CHOLMOD_NOT_POSDEF)
+      throw NotPositiveDefinite("Cholmod factorisation failed: " + status_name(m.c.status));
     throw SolverError("Cholmod factorisation failed: " + status_name(m.c.status));
+  }
   auto bv = b.getLocalViewDevice(Tpetra::Access::ReadOnly);
   cholmod_dense B{};
   B.nrow = S.nrow;

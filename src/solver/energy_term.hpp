@@ -91,13 +91,13 @@ class DeformationTerm : public EnergyTerm<dim> {
   // stencils at once with atomic adds.
   void assemble(ConstDofView x, const Sink<dim>& sink) const override {
     if (coloring_.colors() == 0) {
-      deformation_assemble(s_, x, sink, project_);
+      deformation_assemble(s_, x, sink, project_ && sink.project);
       return;
     }
     Sink<dim> plain = sink;
     plain.atomic = false;  // the stencils of one color share no node
     for (int c = 0; c < coloring_.colors(); ++c)
-      deformation_assemble(s_, x, plain, project_, coloring_.order, coloring_.color_start[c],
+      deformation_assemble(s_, x, plain, project_ && sink.project, coloring_.order, coloring_.color_start[c],
                            coloring_.color_start[c + 1]);
   }
   // Stencils grouped so that none of one color shares a node (solver/stencil_coloring.hpp).

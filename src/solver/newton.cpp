@@ -1,5 +1,7 @@
 #include "solver/newton.hpp"
 
+#include <cstdio>
+
 #include <Kokkos_Timer.hpp>
 #include <Teuchos_CommHelpers.hpp>
 #include <Tpetra_CrsMatrix.hpp>
@@ -77,14 +79,15 @@ struct NewtonSolver<dim>::Impl {
   }
 
   // Gradient, projected Hessian and right-hand side at x.
-  void assemble(const IncrementalPotential& ip, CView1 x) {
+  void assemble(const IncrementalPotential& ip, CView1 x, bool project) {
     auto g = grad;
     auto r = rhs;
     auto dxp = dx_prescribed;
     Kokkos::deep_copy(g, 0.0);
     Kokkos::deep_copy(r, 0.0);
     dofs.begin_assembly();
-    const Sink<dim> sink = dofs.sink(ip.h, g, r, ip.prescribed, dxp);
+    Sink<dim> sink = dofs.sink(ip.h, g, r, ip.prescribed, dxp);
+    sink.project = project;
     for (const auto* t : dofs.terms()) {
       Kokkos::Timer timer;
       t->assemble(x, sink);
@@ -206,6 +209,8 @@ NewtonStats NewtonSolver<dim>::minimize(const IncrementalPotential& ip, View1 x)
   auto dir = m.dir;
   auto trial = m.trial;
   double r0_norm = 0;
+  const bool try_exact =
+      m.params.hessian == HessianMode::ExactIfDefinite && m.solver.kind() == LinearSolverKind::Cholmod;
   if (m.modes_stale || ++m.solves_since_modes >= m.solver.near_null_space_every()) m.refresh_modes(x);
   for (int it = 0; it < m.params.max_iterations; ++it) {
     // Remaining offset of the prescribed DOFs.
@@ -230,7 +235,8 @@ NewtonStats NewtonSolver<dim>::minimize(const IncrementalPotential& ip, View1 x)
       m.refresh_modes(x);
       ++st.graph_builds;
     }
-    m.assemble(ip, x);
+    bool project = !try_exact;
+    m.assemble(ip, x, project);
     if (m.dofs.dropped_blocks() > 0) {
       // A term's couplings were not in the cached graph: never drop them.
       m.dofs.rebuild();
@@ -238,7 +244,7 @@ NewtonStats NewtonSolver<dim>::minimize(const IncrementalPotential& ip, View1 x)
       m.refresh_modes(x);
       m.dofs.count_missing_block_rebuild();
       ++st.graph_builds;
-      m.assemble(ip, x);
+      m.assemble(ip, x, project);
       if (m.dofs.dropped_blocks() > 0)
         throw std::logic_error("DOF space: a term assembles blocks its add_couplings does not declare");
     }
@@ -253,7 +259,24 @@ NewtonStats NewtonSolver<dim>::minimize(const IncrementalPotential& ip, View1 x)
     const double r_norm = m.b->norm2();
     if (it == 0) r0_norm = r_norm;
     const double forcing = r0_norm > 0 ? r_norm / r0_norm : 0.0;
-    const LinearSolveStats ls = m.solver.solve(*m.b, *m.p, forcing > 0 ? forcing : 1e-300);
+    LinearSolveStats ls;
+    try {
+      ls = m.solver.solve(*m.b, *m.p, forcing > 0 ? forcing : 1e-300);
+    } catch (const NotPositiveDefinite&) {
+      if (project) throw;
+      // The exact Hessian is indefinite here: the projected one for this iteration.
+      st.solve_s += timer.seconds();
+      ++st.projection_fallbacks;
+      project = true;
+      timer.reset();
+      m.assemble(ip, x, project);
+      Kokkos::fence();
+      st.assembly_s += timer.seconds();
+      timer.reset();
+      m.p->putScalar(0.0);
+      ls = m.solver.solve(*m.b, *m.p, forcing > 0 ? forcing : 1e-300);
+    }
+    if (!project) ++st.exact_hessian_iterations;
     st.linear_iterations += ls.iterations;
     if (ls.refactored) ++st.symbolic_factorizations;
     m.dofs.to_local(*m.p, dir);
@@ -367,6 +390,9 @@ NewtonStats NewtonSolver<dim>::minimize(const IncrementalPotential& ip, View1 x)
     Kokkos::fence();
     st.line_search_s += timer.seconds();
     st.min_step = std::min(st.min_step, alpha);
+    if (m.params.log_iterations && m.comm->getRank() == 0)
+      std::fprintf(stderr, "  newton %3d  |p|/dt %.3e m/s  step %.3e  (bound %.3e)  |rhs| %.3e  %s Hessian\n", it + 1,
+                   p_inf / ip.dt, alpha, 0.9 * a_max, r_norm, project ? "projected" : "exact");
     st.iterations = it + 1;
     if (on_iterate) on_iterate(x);
     if (converged) return st;

@@ -22,9 +22,23 @@
 
 namespace bfemp {
 
+// Which Hessian the Newton direction solves with.
+//   Projected: every stencil's local Hessian projected onto the PSD cone
+//     (the paper's projected Newton; always a descent direction).
+//   ExactIfDefinite: the exact Hessian first; when its Cholesky factorisation
+//     meets a non-positive pivot, the projected one for that iteration. A
+//     positive definite exact Hessian still gives a descent direction, and
+//     near the minimum it converges quadratically where the projection (of
+//     the barrier's b' grad^2 d, of compressed neo-Hookean twist modes) makes
+//     the convergence linear. Needs a solver that certifies definiteness
+//     (Cholmod); with another the projected Hessian is used.
+enum class HessianMode { Projected, ExactIfDefinite };
+
 struct NewtonParams {
   double eps_d = 1e-6;     // m/s
   int max_iterations = 100;
+  HessianMode hessian = HessianMode::Projected;
+  bool log_iterations = false;  // one line per iteration on stderr (rank 0)
 };
 
 struct NewtonStats {
@@ -34,6 +48,8 @@ struct NewtonStats {
   double min_step = 1.0;   // smallest accepted line-search step
   int graph_builds = 0;            // graph rebuilds inside the solve (contact pairs outside the graph)
   int symbolic_factorizations = 0; // direct solvers: symbolic phases run
+  int exact_hessian_iterations = 0; // iterations solved with the exact Hessian
+  int projection_fallbacks = 0;     // exact Hessian not positive definite: projected instead
 };
 
 // Inputs of one minimisation; all Views node-interleaved, length n_nodes*dim.

@@ -171,7 +171,7 @@ struct Assembled {
 
 template <int dim>
 Assembled assemble_dense(const EnergyTerm<dim>& term, LO n_nodes, Kokkos::View<double*, MemSpace> x, double scale,
-                         const std::vector<int>& mask, const HostVec& dx_prescribed) {
+                         const std::vector<int>& mask, const HostVec& dx_prescribed, bool project = true) {
   const std::size_t nd = static_cast<std::size_t>(n_nodes) * dim;
   std::vector<long long> keys;
   term.add_couplings(keys, n_nodes);
@@ -192,7 +192,9 @@ Assembled assemble_dense(const EnergyTerm<dim>& term, LO n_nodes, Kokkos::View<d
     Kokkos::deep_copy(pres, ph);
     Kokkos::deep_copy(dxp, dh);
   }
-  term.assemble(x, make_sink<dim>(A->getLocalMatrixDevice(), scale, grad, rhs, pres, dxp));
+  auto sink = make_sink<dim>(A->getLocalMatrixDevice(), scale, grad, rhs, pres, dxp);
+  sink.project = project;
+  term.assemble(x, sink);
   Kokkos::fence();
   A->fillComplete();
   Assembled out;
@@ -389,6 +391,37 @@ inline void check_energy_term(const EnergyTerm<dim>& term, LO n_nodes, Kokkos::V
     cz.report();
     cr.report();
   }
+}
+
+// The sink's `project` flag (Newton/hessian: exact-if-definite): the term,
+// with its own projection on, assembled through a sink with project = false
+// must give the Hessian and
+// gradient of the term with its projection switched off, which
+// check_energy_term verifies against differences. Returns the number of
+// Hessian entries where the projected assembly differs from the exact one:
+// a case must have some for this check to show anything. Leaves the term's
+// projection on.
+template <int dim, class Term>
+std::size_t check_sink_exact_hessian(Term& term, LO n_nodes, Kokkos::View<double*, MemSpace> x) {
+  using namespace fd_detail;
+  term.set_projection(false);
+  const Assembled exact = assemble_dense<dim>(term, n_nodes, x, 1.0, {}, {});
+  term.set_projection(true);
+  const Assembled via_sink = assemble_dense<dim>(term, n_nodes, x, 1.0, {}, {}, false);
+  const Assembled projected = assemble_dense<dim>(term, n_nodes, x, 1.0, {}, {}, true);
+  std::size_t differ = 0, mismatch = 0;
+  double a_max = 0, g_max = 0;
+  for (double v : exact.A) a_max = std::max(a_max, std::abs(v));
+  for (double v : exact.grad) g_max = std::max(g_max, std::abs(v));
+  // Equal up to the order of atomic sums (uncolored terms on several threads).
+  const auto same = [](double a, double b, double floor) { return std::abs(a - b) <= 1e-13 * std::abs(a) + floor; };
+  for (std::size_t k = 0; k < exact.A.size(); ++k) {
+    mismatch += !same(via_sink.A[k], exact.A[k], 1e-15 * a_max);
+    differ += std::abs(projected.A[k] - exact.A[k]) > 1e-9 * std::abs(exact.A[k]) + 1e-300;
+  }
+  for (std::size_t i = 0; i < exact.grad.size(); ++i) mismatch += !same(via_sink.grad[i], exact.grad[i], 1e-15 * g_max);
+  EXPECT_EQ(mismatch, 0u) << "assembling through a sink with project = false differs from the exact Hessian";
+  return differ;
 }
 
 }  // namespace bfemp::fixtures

@@ -152,6 +152,9 @@ TEST(ContactPotentials, BarrierDerivatives2D) {
   barrier.set_projection(false);
   ASSERT_GT(barrier.energy(s.x), 0.0);
   fixtures::check_energy_term<2>(barrier, s.n_nodes, s.x, kFdStep, 1e-5);
+  // The same exact Hessian through a sink with project = false (b' grad^2 d
+  // makes the local Hessians indefinite: the projection changes them).
+  EXPECT_GT(fixtures::check_sink_exact_hessian<2>(barrier, s.n_nodes, s.x), 0u);
 }
 
 TEST(ContactPotentials, BarrierDerivatives3D) {
@@ -165,6 +168,7 @@ TEST(ContactPotentials, BarrierDerivatives3D) {
   barrier.set_projection(false);
   ASSERT_GT(barrier.energy(s.x), 0.0);
   fixtures::check_energy_term<3>(barrier, s.n_nodes, s.x, kFdStep, 1e-5);
+  EXPECT_GT(fixtures::check_sink_exact_hessian<3>(barrier, s.n_nodes, s.x), 0u);
 }
 
 template <int dim>

@@ -25,8 +25,11 @@ void check_term(DeformationTerm<dim, nv>& term, LO n_nodes, Kokkos::View<double*
   fixtures::check_energy_term<dim>(term, n_nodes, x, fd_h, tol);
 }
 
+// compressed: the nodes squeezed to 55 % along x and sheared after the rest
+// shape is set, so that the neo-Hookean tangent is indefinite (its PSD
+// projection differs from it) and the sink's exact-Hessian path is checked.
 template <int dim>
-void fem_case() {
+void fem_case(bool compressed = false) {
   constexpr int nv = dim + 1;
   // Two simplices sharing a facet, perturbed from rest.
   const int n_nodes = dim + 2;
@@ -63,12 +66,16 @@ void fem_case() {
   std::mt19937 rng(7);
   std::uniform_real_distribution<double> u(-0.02, 0.02);
   for (std::size_t i = 0; i < X.extent(0); ++i) X(i) += u(rng);
+  if (compressed)
+    for (int a = 0; a < n_nodes; ++a) X(a * dim) = 0.55 * X(a * dim) + 0.3 * X(a * dim + 1);
   DeformationTerm<dim, nv> term("fem", s);
   check_term(term, n_nodes, X, 1e-6, 1e-6);
+  if (compressed) EXPECT_GT(fixtures::check_sink_exact_hessian<dim>(term, n_nodes, X), 0u);
 }
 
+// compressed: F^n about 0.5 I (indefinite tangent, as for fem_case).
 template <int dim>
-void mpm_case() {
+void mpm_case(bool compressed = false) {
   constexpr int ns = bspline_stencil_size<dim>;
   GridSpec<dim> grid = grid_covering<dim>(Vec<dim>::Constant(0.0), Vec<dim>::Constant(0.3), 0.1);
   auto p = allocate_particles<dim>(3);
@@ -82,7 +89,7 @@ void mpm_case() {
   for (int q = 0; q < 3; ++q) {
     for (int d = 0; d < dim; ++d) p.x(q, d) = pos(rng);
     for (int i = 0; i < dim; ++i)
-      for (int j = 0; j < dim; ++j) p.F(q, i, j) = (i == j) + pert(rng);  // F^n away from I
+      for (int j = 0; j < dim; ++j) p.F(q, i, j) = (compressed ? 0.5 : 1.0) * (i == j) + pert(rng);  // F^n away from I
     p.volume0(q) = 1e-3;
     p.mass(q) = 0.1;
   }
@@ -108,6 +115,7 @@ void mpm_case() {
   bin_particles<dim>(grid, p, cells);
   term.set_cells(cells);
   check_term(term, n, x, 1e-7, 1e-5);
+  if (compressed) EXPECT_GT(fixtures::check_sink_exact_hessian<dim>(term, n, x), 0u);
 }
 
 }  // namespace
@@ -116,3 +124,7 @@ TEST(EnergyDerivatives, FemTriangles) { fem_case<2>(); }
 TEST(EnergyDerivatives, FemTetrahedra) { fem_case<3>(); }
 TEST(EnergyDerivatives, MpmParticles2D) { mpm_case<2>(); }
 TEST(EnergyDerivatives, MpmParticles3D) { mpm_case<3>(); }
+TEST(EnergyDerivatives, CompressedFemTrianglesExactThroughTheSink) { fem_case<2>(true); }
+TEST(EnergyDerivatives, CompressedFemTetrahedraExactThroughTheSink) { fem_case<3>(true); }
+TEST(EnergyDerivatives, CompressedMpmParticles2DExactThroughTheSink) { mpm_case<2>(true); }
+TEST(EnergyDerivatives, CompressedMpmParticles3DExactThroughTheSink) { mpm_case<3>(true); }
