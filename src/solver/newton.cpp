@@ -78,7 +78,8 @@ struct NewtonSolver<dim>::Impl {
     solver.set_near_null_space(modes, dim);
   }
 
-  // Gradient, projected Hessian and right-hand side at x.
+  // Gradient, Hessian (PSD-projected per stencil when `project`, exact
+  // otherwise) and right-hand side at x.
   void assemble(const IncrementalPotential& ip, CView1 x, bool project) {
     auto g = grad;
     auto r = rhs;
