@@ -12,6 +12,8 @@
 //       // pairs(k, 0) = query, pairs(k, 1) = box for every overlapping (closed, touching counts)
 //       // pair, each once; sorted by query then box (deterministic for any thread count);
 //       // returns the count; `pairs` grows when too small (never shrinks).
+//     LO query(queries, pairs, keep);   // only the pairs with keep(q, j) true (a device predicate,
+//                                       // e.g. no contact of an FEM body with itself)
 //     const SpatialHashStats& stats() const;  // cell size, entries, oversize count, buckets
 //     std::size_t storage_capacity() const;    // allocated entries (for reuse checks)
 //   };
@@ -267,6 +269,13 @@ class SpatialHash {
   }
 
   LO query(const Boxes<dim>& queries, Kokkos::View<LO* [2], MemSpace>& pairs) {
+    return query(queries, pairs, KeepAll{});
+  }
+  struct KeepAll {
+    KOKKOS_INLINE_FUNCTION bool operator()(LO, LO) const { return true; }
+  };
+  template <class Keep>
+  LO query(const Boxes<dim>& queries, Kokkos::View<LO* [2], MemSpace>& pairs, const Keep& keep) {
     using namespace broad_phase_detail;
     const LO m = queries.size();
     if (m == 0 || t_.n == 0) return 0;
@@ -279,7 +288,7 @@ class SpatialHash {
           double lo[dim], hi[dim];
           for (int d = 0; d < dim; ++d) lo[d] = qlo(q, d), hi[d] = qhi(q, d);
           std::int64_t c = 0;
-          auto emit = [&](LO) { ++c; };
+          auto emit = [&](LO j) { c += keep(q, j) ? 1 : 0; };
           tr.visit(lo, hi, emit);
           off(q) = c;
         });
@@ -303,6 +312,7 @@ class SpatialHash {
           for (int d = 0; d < dim; ++d) lo[d] = qlo(q, d), hi[d] = qhi(q, d);
           std::int64_t k = off(q);
           auto emit = [&](LO j) {
+            if (!keep(q, j)) return;
             pr(k, 0) = q;
             pr(k, 1) = j;
             ++k;

@@ -9,6 +9,7 @@
 // the local ones (scatter_pair hands them to the DOF space's sink, which
 // eliminates prescribed DOFs).
 #include <Kokkos_Core.hpp>
+#include <climits>
 #include <cmath>
 #include <type_traits>
 
@@ -27,9 +28,24 @@ struct ParticleStencils {
   Kokkos::View<LO* [ns], MemSpace> nodes;  // system node ids
   Kokkos::View<double* [ns], MemSpace> w;  // weights, sum 1
   Kokkos::View<double*, MemSpace> omega;   // m (2D) or m^2 (3D)
-  Kokkos::View<int*, MemSpace> body;       // MPM body index
+  Kokkos::View<int*, MemSpace> body;       // MPM body index; FEM points: fem_body_base + FEM body
+  // FEM-FEM contact (2D): the boundary nodes of the FEM bodies join the
+  // points after the particles, each with a one-node stencil (weight 1 on
+  // its own system node, 0 on the others) and omega = half the rest length
+  // of its boundary edges; body(q) = fem_body_base + its FEM body, so that
+  // pairs of a body with itself can be dropped (fem_body_base = the number of
+  // MPM bodies; without FEM points, INT_MAX).
+  int fem_body_base = INT_MAX;
   LO size() const { return static_cast<LO>(omega.extent(0)); }
 };
+
+// Whether point q and primitive j may form a pair: not when q is a node of
+// an FEM body and j belongs to the same body (a node lies on its own facets).
+template <int dim, class Prims>
+KOKKOS_INLINE_FUNCTION bool contact_allowed(const ParticleStencils<dim>& ps, const Prims& prims, LO q, LO j) {
+  const int b = ps.body(q);
+  return b < ps.fem_body_base || b - ps.fem_body_base != prims.body(j);
+}
 
 template <int dim>
 KOKKOS_INLINE_FUNCTION double particle_contact_weight(double volume0) {

@@ -2,6 +2,7 @@
 
 #include <Kokkos_Timer.hpp>
 #include <algorithm>
+#include <climits>
 #include <limits>
 #include <type_traits>
 
@@ -26,6 +27,14 @@ KOKKOS_INLINE_FUNCTION double pair_distance2(const Prims& prims, const ConstDofV
   });
   return d2;
 }
+
+// Drops the pairs of an FEM body's boundary node with the body's own facets.
+template <int dim>
+struct PairFilter {
+  ParticleStencils<dim> ps;
+  BoundaryPrimitives<dim> prims;
+  KOKKOS_INLINE_FUNCTION bool operator()(LO q, LO j) const { return contact_allowed<dim>(ps, prims, q, j); }
+};
 
 constexpr double kCcdStepMax = 1.0 / 0.9;  // the solver takes 0.9 of the bound, capped at 1
 
@@ -97,7 +106,13 @@ void BarrierTerm<dim>::find_pairs(ConstDofView x, ConstDofView p) const {
   point_boxes<dim>(xq_, moving ? ConstDofView(dq_) : ConstDofView(), 0.0, particle_boxes_);
   simplex_boxes<dim, dim>(prims_.nodes, x, p, dhat_, prim_boxes_);
   hash_.build(prim_boxes_);
-  n_pairs_ = prims_.size() > 0 && ps_.size() > 0 ? hash_.query(particle_boxes_, pairs_) : 0;
+  if (prims_.size() == 0 || ps_.size() == 0) {
+    n_pairs_ = 0;
+  } else if (ps_.fem_body_base == INT_MAX) {  // particles only: every pair may touch
+    n_pairs_ = hash_.query(particle_boxes_, pairs_);
+  } else {  // FEM points too: not against their own body
+    n_pairs_ = hash_.query(particle_boxes_, pairs_, PairFilter<dim>{ps_, prims_});
+  }
 }
 
 template <int dim>

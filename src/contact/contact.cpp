@@ -1,5 +1,7 @@
 #include "contact/contact.hpp"
 
+#include <climits>
+#include <cmath>
 #include <limits>
 #include <sstream>
 #include <stdexcept>
@@ -16,18 +18,80 @@ Contact<dim>::Contact(const FemMesh<dim>& mesh, ContactParams params) : mesh_(me
   if (any_mu)
     friction_ = std::make_unique<FrictionTerm<dim>>(*barrier_, params_.mu, static_cast<int>(mesh.bodies.size()),
                                                     params_.eps_v);
+  // Element bodies (for the inside tests of FEM points).
+  element_body_ = Kokkos::View<int*, MemSpace>("contact_element_body", mesh.num_cells());
+  auto eb = Kokkos::create_mirror_view(element_body_);
+  for (std::size_t b = 0; b < mesh.bodies.size(); ++b)
+    for (LO e = mesh.bodies[b].first_cell; e < mesh.bodies[b].first_cell + mesh.bodies[b].num_cells; ++e)
+      eb(e) = static_cast<int>(b);
+  Kokkos::deep_copy(element_body_, eb);
+  if (!params_.fem_fem) return;
+  if constexpr (dim == 3)
+    throw std::invalid_argument("Contact/FEM-FEM: true: contact between FEM bodies runs in 2D only in this version "
+                                "(3D needs edge-edge pairs); expected false in a 3D scene");
+  // Contact points: the nodes of the boundary facets, omega = half the rest
+  // length of the facets at the node (IPC's boundary-node weight).
+  const auto& prims = barrier_->primitives();
+  auto pn = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), prims.nodes);
+  auto pb = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), prims.body);
+  auto X = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), mesh.rest_position);
+  std::vector<double> w(static_cast<std::size_t>(mesh.num_nodes()), 0.0);
+  std::vector<int> body(w.size(), -1);
+  for (LO j = 0; j < prims.num_facets; ++j) {
+    double len2 = 0;
+    for (int c = 0; c < dim; ++c) {
+      const double d = X(pn(j, 1) * dim + c) - X(pn(j, 0) * dim + c);
+      len2 += d * d;
+    }
+    for (int a = 0; a < 2; ++a) {
+      w[pn(j, a)] += 0.5 * std::sqrt(len2);
+      body[pn(j, a)] = pb(j);
+    }
+  }
+  std::vector<LO> nodes;
+  for (LO n = 0; n < mesh.num_nodes(); ++n)
+    if (w[n] > 0) nodes.push_back(n);
+  const std::size_t m = nodes.size();
+  fem_point_node_ = Kokkos::View<LO*, MemSpace>("contact_fem_point_node", m);
+  fem_point_omega_ = Kokkos::View<double*, MemSpace>("contact_fem_point_omega", m);
+  fem_point_body_ = Kokkos::View<int*, MemSpace>("contact_fem_point_body", m);
+  auto hn = Kokkos::create_mirror_view(fem_point_node_);
+  auto hw = Kokkos::create_mirror_view(fem_point_omega_);
+  auto hb = Kokkos::create_mirror_view(fem_point_body_);
+  for (std::size_t k = 0; k < m; ++k) {
+    hn(k) = nodes[k];
+    hw(k) = w[nodes[k]];
+    hb(k) = body[nodes[k]];
+  }
+  Kokkos::deep_copy(fem_point_node_, hn);
+  Kokkos::deep_copy(fem_point_omega_, hw);
+  Kokkos::deep_copy(fem_point_body_, hb);
 }
 
+namespace {
+// Point q against element e: FEM points (q >= first) skip their own body.
+struct InsideFilter {
+  LO first;
+  Kokkos::View<int*, MemSpace> point_body, element_body;
+  KOKKOS_INLINE_FUNCTION bool operator()(LO q, LO e) const {
+    return q < first || point_body(q - first) != element_body(e);
+  }
+};
+}  // namespace
+
 template <int dim>
-LO Contact<dim>::particle_inside(ConstDofView xp, ConstDofView x) const {
+LO Contact<dim>::inside(ConstDofView xp, ConstDofView x, LO first_fem_point) const {
   const auto& el = mesh_.elements;
   const LO np = static_cast<LO>(xp.extent(0) / dim);
   if (el.size() == 0 || np == 0) return -1;
-  // Hash the elements, query the particles; inside or on an element counts.
+  // Hash the elements, query the points; inside or on an element counts.
   simplex_boxes<dim, dim + 1>(el.nodes, x, ConstDofView(), 0.0, element_boxes_);
   point_boxes<dim>(xp, ConstDofView(), 0.0, point_boxes_);
   element_hash_.build(element_boxes_);
-  const LO n = element_hash_.query(point_boxes_, inside_pairs_);
+  const LO n = first_fem_point >= np
+                   ? element_hash_.query(point_boxes_, inside_pairs_)
+                   : element_hash_.query(point_boxes_, inside_pairs_,
+                                         InsideFilter{first_fem_point, fem_point_body_, element_body_});
   const auto pairs = inside_pairs_;
   const auto nodes = el.nodes;
   LO bad = -1;
@@ -40,6 +104,11 @@ LO Contact<dim>::particle_inside(ConstDofView xp, ConstDofView x) const {
       },
       Kokkos::Max<LO>(bad));
   return bad;
+}
+
+template <int dim>
+LO Contact<dim>::particle_inside(ConstDofView xp, ConstDofView x) const {
+  return inside(xp, x, static_cast<LO>(xp.extent(0) / dim));
 }
 
 template <int dim>
@@ -73,7 +142,7 @@ template <int dim>
 LO Contact<dim>::particle_inside_at(ConstDofView x) const {
   Kokkos::View<double*, MemSpace> xp("contact_inside_xp", static_cast<std::size_t>(ps_.size()) * dim);
   interpolate_particles(ps_, x, xp);
-  return particle_inside(xp, x);
+  return inside(xp, x, n_particles_);
 }
 
 template <int dim>
@@ -82,39 +151,88 @@ void Contact<dim>::check_initial(const Particles<dim>& p, ConstDofView x_fem) co
   Kokkos::View<double*, MemSpace> xp("contact_check_xp", static_cast<std::size_t>(np) * dim);
   interleaved_positions(p, xp);
   const LO bad = particle_inside(xp, x_fem);
+  if (bad >= 0) {
+    auto h = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), p.x);
+    std::ostringstream msg;
+    msg << "MPM particle " << bad << " at (";
+    for (int c = 0; c < dim; ++c) msg << (c ? ", " : "") << h(bad, c);
+    msg << ") starts inside or on an FEM body: the MPM and FEM bodies must not intersect or touch at t = 0 "
+           "(paper Eq. 15); move the bodies apart";
+    throw std::invalid_argument(msg.str());
+  }
+  check_initial_fem(x_fem);
+}
+
+template <int dim>
+void Contact<dim>::check_initial_fem(ConstDofView x_fem) const {
+  const LO m = num_fem_points();
+  if (m == 0) return;
+  Kokkos::View<double*, MemSpace> xn("contact_check_fem_points", static_cast<std::size_t>(m) * dim);
+  const auto node = fem_point_node_;
+  Kokkos::parallel_for(
+      "contact_fem_point_positions", Kokkos::RangePolicy<ExecSpace>(0, m), KOKKOS_LAMBDA(const LO k) {
+        for (int c = 0; c < dim; ++c) xn(k * dim + c) = x_fem(node(k) * dim + c);
+      });
+  const LO bad = inside(xn, x_fem, 0);
   if (bad < 0) return;
-  auto h = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), p.x);
+  auto hn = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), fem_point_node_);
+  auto hb = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), fem_point_body_);
+  auto hx = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), xn);
   std::ostringstream msg;
-  msg << "MPM particle " << bad << " at (";
-  for (int c = 0; c < dim; ++c) msg << (c ? ", " : "") << h(bad, c);
-  msg << ") starts inside or on an FEM body: the MPM and FEM bodies must not intersect or touch at t = 0 "
-         "(paper Eq. 15); move the bodies apart";
+  msg << "FEM node " << hn(bad) << " of body '" << mesh_.bodies[hb(bad)].name << "' at (";
+  for (int c = 0; c < dim; ++c) msg << (c ? ", " : "") << hx(bad * dim + c);
+  msg << ") starts inside or on another FEM body (Contact/FEM-FEM: true): FEM bodies in contact must not "
+         "intersect or touch at t = 0; move them apart";
   throw std::invalid_argument(msg.str());
 }
 
 template <int dim>
-void Contact<dim>::begin_step(const MpmBodies<dim>& mpm, ConstDofView x) {
+void Contact<dim>::begin_step(const MpmBodies<dim>* mpm, ConstDofView x) {
   constexpr int ns = ParticleStencils<dim>::ns;
-  const auto& p = mpm.particles();
-  const LO np = static_cast<LO>(p.size());
-  if (ps_.size() != np) {
-    ps_.nodes = decltype(ps_.nodes)("contact_particle_nodes", np);
-    ps_.w = decltype(ps_.w)("contact_particle_w", np);
-    ps_.omega = Kokkos::View<double*, MemSpace>("contact_omega", np);
-    ps_.body = p.body;
+  const LO np = mpm ? static_cast<LO>(mpm->particles().size()) : 0;
+  const LO nfp = num_fem_points();
+  const LO n = np + nfp;
+  n_particles_ = np;
+  if (ps_.size() != n) {
+    ps_.nodes = decltype(ps_.nodes)("contact_particle_nodes", n);
+    ps_.w = decltype(ps_.w)("contact_particle_w", n);
+    ps_.omega = Kokkos::View<double*, MemSpace>("contact_omega", n);
+    ps_.body = nfp > 0 || !mpm ? Kokkos::View<int*, MemSpace>("contact_point_body", n) : mpm->particles().body;
+    ps_.fem_body_base = nfp > 0 ? params_.mpm_bodies : INT_MAX;
   }
-  const auto grid = mpm.grid();
-  const auto sys = mpm.system_node();
   const auto ps = ps_;
-  Kokkos::parallel_for(
-      "contact_particle_stencils", Kokkos::RangePolicy<ExecSpace>(0, np), KOKKOS_LAMBDA(const LO q) {
-        const auto st = bspline_stencil(grid, particle_position(p, q));
-        for (int a = 0; a < ns; ++a) {
-          ps.nodes(q, a) = sys(node_index(grid, st, a));
-          ps.w(q, a) = weight(st, a);
-        }
-        ps.omega(q) = particle_contact_weight<dim>(p.volume0(q));
-      });
+  if (mpm) {
+    const auto& p = mpm->particles();
+    const auto grid = mpm->grid();
+    const auto sys = mpm->system_node();
+    const bool copy_body = nfp > 0;
+    Kokkos::parallel_for(
+        "contact_particle_stencils", Kokkos::RangePolicy<ExecSpace>(0, np), KOKKOS_LAMBDA(const LO q) {
+          const auto st = bspline_stencil(grid, particle_position(p, q));
+          for (int a = 0; a < ns; ++a) {
+            ps.nodes(q, a) = sys(node_index(grid, st, a));
+            ps.w(q, a) = weight(st, a);
+          }
+          ps.omega(q) = particle_contact_weight<dim>(p.volume0(q));
+          if (copy_body) ps.body(q) = p.body(q);
+        });
+  }
+  if (nfp > 0) {
+    const auto node = fem_point_node_;
+    const auto omega = fem_point_omega_;
+    const auto body = fem_point_body_;
+    const int base = ps_.fem_body_base;
+    Kokkos::parallel_for(
+        "contact_fem_point_stencils", Kokkos::RangePolicy<ExecSpace>(0, nfp), KOKKOS_LAMBDA(const LO k) {
+          const LO q = np + k;
+          for (int a = 0; a < ns; ++a) {  // the node itself, weight 1 (the other slots add nothing)
+            ps.nodes(q, a) = node(k);
+            ps.w(q, a) = a == 0 ? 1.0 : 0.0;
+          }
+          ps.omega(q) = omega(k);
+          ps.body(q) = base + body(k);
+        });
+  }
   barrier_->begin_step(ps_, x);
   if (friction_) friction_->clear();
 }

@@ -22,6 +22,12 @@ struct ContactParams {
   std::vector<double> mu;  // [mpm body * n_fem + fem body]; empty: frictionless
   int force_body = -1;     // FEM body whose contact force is reported (-1: all)
   bool check_iterates = false;  // debug: every Newton iterate is checked for penetration
+  // FEM-FEM contact (2D): the boundary nodes of every FEM body against the
+  // facets of every other FEM body, beside the particles; mu then has
+  // (mpm_bodies + n_fem) * n_fem entries, FEM body a against FEM body b at
+  // [(mpm_bodies + a) * n_fem + b].
+  bool fem_fem = false;
+  int mpm_bodies = 0;  // MPM bodies of the scene
 };
 
 template <int dim>
@@ -31,7 +37,11 @@ class Contact {
 
   // Throws std::invalid_argument naming the particle when one starts inside
   // an FEM element or at distance <= 0 from the FEM boundary (x: FEM nodes).
+  // With FEM-FEM contact it also runs check_initial_fem.
   void check_initial(const Particles<dim>& p, ConstDofView x_fem) const;
+  // FEM-FEM contact: throws naming the FEM node and its body when a boundary
+  // node starts inside or on another FEM body.
+  void check_initial_fem(ConstDofView x_fem) const;
   // Largest index of a particle inside or on an FEM element (-1: none), for
   // particle positions xp (node-interleaved) and FEM positions x (the first
   // FEM-node entries of x are read). particle_inside_at interpolates the
@@ -41,8 +51,13 @@ class Contact {
   // How many particles (xp, node-interleaved) lie inside or on an FEM element.
   LO count_inside(ConstDofView xp, ConstDofView x) const;
 
-  // Per step, after the MPM grid is activated: stencils and pairs near x^n.
-  void begin_step(const MpmBodies<dim>& mpm, ConstDofView x);
+  // Per step, after the MPM grid is activated: stencils and pairs near x^n
+  // (mpm null: a scene of FEM bodies only, in contact with each other).
+  void begin_step(const MpmBodies<dim>* mpm, ConstDofView x);
+  void begin_step(const MpmBodies<dim>& mpm, ConstDofView x) { begin_step(&mpm, x); }
+  // FEM-FEM contact: the boundary nodes taking part as contact points (in the
+  // order they follow the particles), and their count.
+  LO num_fem_points() const { return static_cast<LO>(fem_point_node_.extent(0)); }
   const BarrierTerm<dim>* barrier() const { return barrier_.get(); }
   const FrictionTerm<dim>* friction() const { return friction_.get(); }
   bool has_friction() const { return friction_ != nullptr; }
@@ -64,8 +79,13 @@ class Contact {
   };
   // At the step's solution x (system DOFs; the first n_fem_nodes are FEM).
   Report report(ConstDofView x, LO n_fem_nodes);
-  // Contact force per particle at the last report (node-interleaved).
-  Kokkos::View<const double*, MemSpace> particle_forces() const { return particle_force_; }
+  // Contact force per particle at the last report (node-interleaved; the
+  // particles only, not the FEM points).
+  Kokkos::View<const double*, MemSpace> particle_forces() const {
+    const std::size_t n = static_cast<std::size_t>(n_particles_) * dim;
+    if (particle_force_.extent(0) < n) return particle_force_;  // before the first report
+    return Kokkos::subview(particle_force_, std::make_pair(std::size_t(0), n));
+  }
   const ContactParams& params() const { return params_; }
 
  private:
@@ -79,6 +99,15 @@ class Contact {
   mutable Boxes<dim> element_boxes_, point_boxes_;
   mutable Kokkos::View<LO* [2], MemSpace> inside_pairs_;
   mutable Kokkos::View<int*, MemSpace> inside_flag_;
+  // FEM-FEM: per contact point its FEM node, omega (m) and FEM body; per
+  // element its FEM body; the particles of the current step.
+  Kokkos::View<LO*, MemSpace> fem_point_node_;
+  Kokkos::View<double*, MemSpace> fem_point_omega_;
+  Kokkos::View<int*, MemSpace> fem_point_body_, element_body_;
+  LO n_particles_ = 0;
+  // Largest point of xp inside or on an FEM element, where points from
+  // first_fem_point on are FEM nodes (fem_point_body_) that skip their own body.
+  LO inside(ConstDofView xp, ConstDofView x, LO first_fem_point) const;
 };
 
 }  // namespace bfemp

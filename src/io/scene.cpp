@@ -88,15 +88,20 @@ ContactParams contact_from(const ParameterList& p) {
   cp.eps_v = c.get<double>("eps_v");
   cp.friction_max_iterations = c.get<int>("friction iterations");
   const std::size_t nm = mpm.numParams(), nf = fem.numParams();
-  cp.mu.assign(nm * nf, c.get<double>("friction"));
+  cp.fem_fem = c.get<bool>("FEM-FEM");
+  cp.mpm_bodies = static_cast<int>(nm);
+  cp.mu.assign((cp.fem_fem ? nm + nf : nm) * nf, c.get<double>("friction"));
   const auto& pairs = c.sublist("Friction Pairs");
   for (auto it = pairs.begin(); it != pairs.end(); ++it) {
     const std::string key = "Contact/Friction Pairs/" + pairs.name(it);
     const std::string name = pairs.name(it);
     const auto colon = name.find(':');
-    const int a = colon == std::string::npos ? -1 : index_of(mpm, trim(name.substr(0, colon)));
+    int a = colon == std::string::npos ? -1 : index_of(mpm, trim(name.substr(0, colon)));
     const int b = colon == std::string::npos ? -1 : index_of(fem, trim(name.substr(colon + 1)));
-    if (a < 0 || b < 0) bad(key, "'" + name + "'", "a key '<MPM body> : <FEM body>' naming bodies of the scene");
+    int fa = -1;  // FEM-FEM: the first name is an FEM body
+    if (a < 0 && cp.fem_fem && colon != std::string::npos) fa = index_of(fem, trim(name.substr(0, colon)));
+    if (fa >= 0) a = static_cast<int>(nm) + fa;
+    if (a < 0 || b < 0 || fa == b) bad(key, "'" + name + "'", "a key '<MPM body> : <FEM body>' naming bodies of the scene");
     const auto& e = pairs.entry(it);
     double mu = -1;
     if (e.isType<double>()) mu = Teuchos::getValue<double>(e);
@@ -104,6 +109,7 @@ ContactParams contact_from(const ParameterList& p) {
     else bad(key, Teuchos::toString(e.getAny()), "a number mu >= 0");
     if (!(mu >= 0)) bad(key, num(mu), "mu >= 0");
     cp.mu[a * nf + b] = mu;
+    if (fa >= 0) cp.mu[(nm + b) * nf + fa] = mu;  // symmetric
   }
   const std::string fb = c.get<std::string>("force body");
   cp.force_body = fb.empty() ? -1 : index_of(fem, fb);
@@ -387,7 +393,12 @@ SimulationSetup<dim> build_setup(const Scene& scene) {
   }
   build_mpm<dim>(scene, mat_names, setup);
   check_friction_pairs(p);
-  if (setup.mpm && !setup.bodies.empty() && p.sublist("Contact").get<bool>("enabled")) setup.contact = contact_from(p);
+  const bool fem_fem = p.sublist("Contact").get<bool>("FEM-FEM");
+  if (fem_fem && dim == 3) bad("Contact/FEM-FEM", "true", "false in a 3D scene (FEM-FEM contact is 2D only: 3D needs edge-edge pairs)");
+  if (fem_fem && setup.bodies.size() < 2)
+    bad("Contact/FEM-FEM", "true", "at least two FEM bodies (the scene has " + std::to_string(setup.bodies.size()) + ")");
+  if (((setup.mpm && !setup.bodies.empty()) || fem_fem) && p.sublist("Contact").get<bool>("enabled"))
+    setup.contact = contact_from(p);
   const auto& time = p.sublist("Time");
   setup.dt = time.get<double>("dt");
   setup.count_penetrations = p.sublist("Output").get<bool>("count penetrations");
@@ -466,8 +477,8 @@ std::string scene_summary(const Scene& scene) {
       << (ex ? std::string() : p.sublist("MPM").get<std::string>("transfer") + ", ")
       << p.sublist("Level Sets").numParams() << " level set(s)\n";
   const auto& c = p.sublist("Contact");
-  if (mpm.numParams() > 0 && bodies.numParams() > 0 && c.get<bool>("enabled"))
-    s << "  contact: barrier dhat " << c.get<double>("dhat") << " m, kappa " << c.get<double>("kappa")
+  if (((mpm.numParams() > 0 && bodies.numParams() > 0) || c.get<bool>("FEM-FEM")) && c.get<bool>("enabled"))
+    s << "  contact" << (c.get<bool>("FEM-FEM") ? " (FEM-FEM too)" : "") << ": barrier dhat " << c.get<double>("dhat") << " m, kappa " << c.get<double>("kappa")
       << " Pa, friction " << c.get<double>("friction") << " (" << c.sublist("Friction Pairs").numParams()
       << " pair override(s)), eps_v " << c.get<double>("eps_v") << " m/s\n";
   return s.str();

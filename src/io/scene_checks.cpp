@@ -121,9 +121,15 @@ void check_friction_pairs(const ParameterList& raw) {
   for (auto it = pairs.begin(); it != pairs.end(); ++it) {
     const std::string name = pairs.name(it), key = "Contact/Friction Pairs/" + name;
     const auto colon = name.find(':');
-    if (colon == std::string::npos || !mpm.isSublist(trim(name.substr(0, colon))) ||
-        !fem.isSublist(trim(name.substr(colon + 1))))
-      bad(key, "'" + name + "'", "a key '<MPM body> : <FEM body>' naming bodies of the scene");
+    const bool fem_fem = c.get<bool>("FEM-FEM");
+    const std::string a = colon == std::string::npos ? "" : trim(name.substr(0, colon));
+    const std::string b = colon == std::string::npos ? "" : trim(name.substr(colon + 1));
+    const bool a_ok = mpm.isSublist(a) || (fem_fem && fem.isSublist(a) && a != b);
+    if (colon == std::string::npos || !a_ok || !fem.isSublist(b))
+      bad(key, "'" + name + "'",
+          fem_fem ? "a key '<MPM body> : <FEM body>' or '<FEM body> : <other FEM body>' naming bodies of the scene"
+                  : "a key '<MPM body> : <FEM body>' naming bodies of the scene (FEM body pairs need "
+                    "Contact/FEM-FEM: true)");
     const auto& e = pairs.entry(it);
     double mu = -1;
     if (e.isType<double>()) mu = Teuchos::getValue<double>(e);

@@ -219,10 +219,14 @@ Teuchos::RCP<const ParameterList> scene_schema() {
   contact.set("eps_v", 1e-3, "static-friction velocity bound (m/s), > 0");
   contact.set("friction", 0.0, "Coulomb coefficient mu of every MPM/FEM body pair, >= 0");
   contact.sublist("Friction Pairs", false,
-                  "per-pair mu overriding 'friction': keys '<MPM body> : <FEM body>' (spaces optional)")
+                  "per-pair mu overriding 'friction': keys '<MPM body> : <FEM body>', or '<FEM body> : <FEM body>' "
+                  "with FEM-FEM (spaces optional)")
       .disableRecursiveValidation();
   contact.set("friction iterations", 20, "cap of the outer friction loop per step (paper Algorithm 1), >= 1");
   contact.set("force body", std::string(""), "FEM body whose contact force goes to diagnostics.csv (default: all)");
+  contact.set("FEM-FEM", false,
+              "true: the FEM bodies also contact each other (2D; boundary nodes against the other bodies' edges), "
+              "also in scenes without MPM bodies");
   contact.set("check iterates", false,
               "debug: test every Newton iterate for particles inside FEM bodies; one found is an error");
   return pl;

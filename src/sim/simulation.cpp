@@ -121,15 +121,21 @@ Simulation<dim>::Simulation(SimulationSetup<dim> setup, const Teuchos::RCP<const
   Kokkos::deep_copy(v_, v);
   Kokkos::deep_copy(prescribed_, pres);
   motions_ = device_motions(setup_.motions);
-  if (setup_.contact && mpm_ && mesh_.num_nodes() > 0) {
+  if (setup_.contact && (mpm_ || setup_.contact->fem_fem) && mesh_.num_nodes() > 0) {
+    if (distributed_)
+      throw std::invalid_argument("Contact/FEM-FEM: true runs on 1 MPI rank in this version; this run has " +
+                                  std::to_string(comm->getSize()) + " ranks: run it without mpirun or with -np 1");
     contact_ = std::make_unique<Contact<dim>>(mesh_, *setup_.contact);
-    contact_->check_initial(mpm_->particles(), x_);
+    if (mpm_) contact_->check_initial(mpm_->particles(), x_);
+    else contact_->check_initial_fem(x_);
     if (setup_.contact->check_iterates)
       newton_->on_iterate = [this](Kokkos::View<const double*, MemSpace> x) {
         const LO q = contact_->particle_inside_at(x);
-        if (q >= 0)
-          throw SolverError("MPM particle " + std::to_string(q) +
-                            " is inside or on an FEM body at a Newton iterate (Contact/check iterates)");
+        if (q < 0) return;
+        const LO np = mpm_ ? static_cast<LO>(mpm_->particles().size()) : 0;
+        throw SolverError((q < np ? "MPM particle " + std::to_string(q)
+                                  : "FEM boundary node (contact point " + std::to_string(q - np) + ")") +
+                          " is inside or on an FEM body at a Newton iterate (Contact/check iterates)");
       };
   }
   reset_acceleration();
@@ -289,6 +295,11 @@ StepReport Simulation<dim>::step() {
       Kokkos::deep_copy(Kokkos::subview(a, std::make_pair(off, nd)), 0.0);
     }
     Kokkos::deep_copy(v_old, v);
+  } else if (contact_) {  // FEM bodies only, in contact with each other
+    contact_->begin_step(nullptr, x);
+    terms.push_back(contact_->barrier());
+    if (contact_->has_friction()) terms.push_back(contact_->friction());
+    graph_rebuilt = newton_->set_system(nF, terms);
   }
   Kokkos::parallel_for(
       "predictor", Kokkos::RangePolicy<ExecSpace>(0, nd), KOKKOS_LAMBDA(const std::size_t i) {

@@ -242,3 +242,37 @@ TEST(SceneInput, DeeplyNestedFlowCollectionIsRefusedNotACrash) {
     EXPECT_NE(std::string(e.what()).find("nested deeper"), std::string::npos) << e.what();
   }
 }
+
+// Contact/FEM-FEM: FEM body pairs in Friction Pairs only with it on, a
+// symmetric mu table after the MPM rows, refused in 3D and with one FEM body.
+TEST(SceneInput, FemFemContactKeys) {
+  const std::string two_walls = replaced(kScene, "  Contact:\n",
+                                         "    wall2:\n      material: hard\n      Mesh: {shape: rectangle, center: "
+                                         "[2.5, 0.5], size: [0.2, 0.2], element size: 0.1}\n  Contact:\n");
+  expect_message(error_of(two_walls, {"Contact/Friction Pairs/wall : wall2=0.3"}),
+                 {"Contact/Friction Pairs/wall : wall2", "Contact/FEM-FEM: true"});
+  const Scene s = load(two_walls, {"Contact/FEM-FEM=true", "Contact/Friction Pairs/wall : wall2=0.3"});
+  const auto setup = build_setup<2>(s);
+  ASSERT_TRUE(setup.contact.has_value());
+  EXPECT_TRUE(setup.contact->fem_fem);
+  EXPECT_EQ(setup.contact->mpm_bodies, 2);
+  ASSERT_EQ(setup.contact->mu.size(), (2u + 2u) * 2u);  // (MPM left, right, FEM wall, wall2) x (wall, wall2)
+  EXPECT_EQ(setup.contact->mu[0 * 2 + 0], 0.5);        // left : wall
+  EXPECT_EQ(setup.contact->mu[1 * 2 + 0], 0.2);        // right : wall
+  EXPECT_EQ(setup.contact->mu[(2 + 0) * 2 + 1], 0.3);  // wall : wall2
+  EXPECT_EQ(setup.contact->mu[(2 + 1) * 2 + 0], 0.3);  // wall2 : wall (symmetric)
+  expect_message(error_of(two_walls, {"Contact/FEM-FEM=true", "Contact/Friction Pairs/wall : wall=0.3"}),
+                 {"Contact/Friction Pairs/wall : wall"});
+  expect_message(error_of(kScene, {"Contact/FEM-FEM=true"}), {"Contact/FEM-FEM", "at least two FEM bodies"});
+}
+
+TEST(SceneInput, TheA6SceneBuildsWithFemFemContact) {
+  const Scene s = load_scene(std::string(BFEMP_SOURCE_DIR) + "/inputs/a6_semiring_buckling.yaml", {});
+  const auto setup = build_setup<2>(s);
+  ASSERT_TRUE(setup.contact.has_value());
+  EXPECT_TRUE(setup.contact->fem_fem);
+  // FEM bodies outer (0) and plate (1) after one MPM body: plate : outer = 10.
+  EXPECT_EQ(setup.contact->mu[(1 + 1) * 2 + 0], 10.0);
+  EXPECT_EQ(setup.contact->mu[(1 + 0) * 2 + 1], 10.0);
+  EXPECT_EQ(setup.contact->mu[0 * 2 + 0], 0.0);  // inner : outer
+}
