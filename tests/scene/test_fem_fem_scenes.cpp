@@ -8,7 +8,8 @@
 //    a positive distance below dhat above it, and the contact force on the
 //    plate equals the block's weight;
 //  - the same block sliding on the plate with mu decelerates at mu g (Coulomb
-//    sliding: the smoothed friction f1 is 1 once |u| > eps_v dt).
+//    sliding: the smoothed friction f1 is 1 once |u| > eps_v dt);
+//  - the A6 ci scene's first 0.5 s: plate -> FEM ring -> MPM ring.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -16,6 +17,7 @@
 #include <iostream>
 
 #include "common/fem_fixtures.hpp"
+#include "io/scene.hpp"
 
 using namespace bfemp;
 using namespace bfemp::fixtures;
@@ -174,4 +176,44 @@ TEST(ContactFemFemScene, SlidingBlockDeceleratesAtMuG) {
   const double a = (n * stv - st * sv) / (n * stt - st * st);
   std::cout << "  sliding deceleration " << -a << " m/s^2 (mu g = " << mu * 9.81 << ")\n";
   EXPECT_NEAR(-a, mu * 9.81, 0.01 * mu * 9.81);
+}
+
+// VALIDATION A6 at its ci size (inputs/a6_semiring_buckling.yaml), first
+// 0.5 s: the plate (prescribed, FEM) presses the FEM outer semi-ring through
+// FEM-FEM contact (mu 10), which presses the MPM inner semi-ring through
+// MPM-FEM contact. The inner ring's crown follows the plate down (within the
+// first 0.1 s the gaps close: 1e-3 plate-outer, 1e-2 outer-inner), no
+// particle enters an FEM body, no FEM node enters another FEM body, and the
+// deformation stays symmetric (no buckling this early).
+TEST(ContactFemFemScene, A6PlateDrivesBothRingsThroughContact) {
+  Scene scene = load_scene(std::string(BFEMP_SOURCE_DIR) + "/inputs/a6_semiring_buckling.yaml", {});
+  auto setup = build_setup<2>(scene);
+  setup.count_penetrations = true;
+  Simulation<2> sim(setup, comm());
+  const auto& p = sim.mpm()->particles();
+  auto x0 = Kokkos::create_mirror(Kokkos::HostSpace(), p.x);  // a copy (a mirror view would alias on the host)
+  Kokkos::deep_copy(x0, p.x);
+  std::vector<std::size_t> crown;
+  for (std::size_t q = 0; q < x0.extent(0); ++q)
+    if (std::abs(x0(q, 0)) < 1.0 && x0(q, 1) > 9.5) crown.push_back(q);
+  ASSERT_GT(crown.size(), 10u);
+  auto crown_shift = [&](int c) {
+    auto x = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), p.x);
+    double s = 0;
+    for (std::size_t q : crown) s += x(q, c) - x0(q, c);
+    return s / crown.size();
+  };
+  long contact_steps = 0;
+  for (int k = 0; k < 50; ++k) {
+    const StepReport r = sim.step();
+    EXPECT_EQ(r.penetrations, 0) << "step " << r.step;
+    EXPECT_NO_THROW(sim.contact()->check_initial_fem(sim.positions())) << "step " << r.step;
+    contact_steps += r.contact_pairs > 0 ? 1 : 0;
+  }
+  const double uy = crown_shift(1), ux = crown_shift(0);
+  std::cout << "  after 0.5 m of plate travel: inner crown moved " << uy << " m down, " << ux << " m sideways\n";
+  EXPECT_GT(contact_steps, 40);
+  EXPECT_LT(uy, -0.4);   // plate travel 0.5 m minus the closing of the gaps and the outer ring's squeeze
+  EXPECT_GT(uy, -0.5);   // it cannot pass the plate
+  EXPECT_LT(std::abs(ux), 1e-3);
 }
