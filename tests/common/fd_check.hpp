@@ -424,4 +424,17 @@ std::size_t check_sink_exact_hessian(Term& term, LO n_nodes, Kokkos::View<double
   return differ;
 }
 
+// A term whose local Hessians can be indefinite (barrier contact): with its
+// projection off, its energy must be positive at x (the case is in contact),
+// gradient and Hessian must match differences entry by entry, and the sink's
+// project = false path must give that exact Hessian, which the projection
+// changes somewhere (b' grad^2 d is indefinite). Leaves the projection on.
+template <int dim, class Term>
+void check_exact_term(Term& term, LO n_nodes, Kokkos::View<double*, MemSpace> x, double fd_h, double tol) {
+  term.set_projection(false);
+  ASSERT_GT(term.energy(x), 0.0) << "the case has no active pair";
+  check_energy_term<dim>(term, n_nodes, x, fd_h, tol);
+  EXPECT_GT(check_sink_exact_hessian<dim>(term, n_nodes, x), 0u) << "the projection changes nothing here";
+}
+
 }  // namespace bfemp::fixtures
