@@ -14,6 +14,7 @@
 #include "io/run_output.hpp"
 #include "io/scene_explicit.hpp"
 #include "sim/interrupt.hpp"
+#include "solver/solver_error.hpp"
 
 namespace bfemp {
 
@@ -228,7 +229,21 @@ RunSummary run_dim(const Scene& scene, const std::string& dir, const Teuchos::RC
   std::unique_ptr<InterruptGuard> guard;
   if (opt.handle_signals) guard = std::make_unique<InterruptGuard>();
   for (long n = first; n < n_steps; ++n) {
-    const StepReport r = sim.step();
+    StepReport r;
+    try {
+      r = sim.step();
+    } catch (const SolverError& e) {
+      // A failed step leaves the state of the last completed one (the step
+      // works on copies until Newton returns): checkpoint it, so that the run
+      // can continue with other Newton or linear-solver settings.
+      checkpoint();
+      if (root) out_ptr->close();
+      std::ostringstream msg;
+      msg << e.what() << "\n  the state after step " << sim.step_index() << " (t = " << sim.time()
+          << " s) is checkpointed; continue with other solver settings, e.g.: bfemp restart " << dir
+          << " --set 'Newton/max iterations=1000' (a restart may change Newton/*, Linear Solver/*, Output/*)";
+      throw SolverError(msg.str());
+    }
     if (root) out_ptr->write_diagnostics(r);
     accumulate(s, r);
     // A signal during the last step: the run is complete; finish normally.

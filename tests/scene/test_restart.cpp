@@ -10,6 +10,8 @@
 //    it states, and the restart from the last periodic checkpoint drops the
 //    later frames and rows and still equals the uninterrupted run;
 //  - restart --set of a key that changes the state is refused (exit 2);
+//  - a solver failure checkpoints the last completed step (exit 3), and the
+//    restart with a higher Newton cap equals the run that had it throughout;
 //  - the explicit stepper (Solver: explicit, B1 blocks in contact under the
 //    piston, LR normals, XPIC(5)): the same bit-for-bit continuation, and
 //    SIGTERM mid-run; its frames are listed in bfemp.xdmf.
@@ -414,16 +416,22 @@ TEST(Restart, SetOfAShapeChangingKeyIsRefused) {
 }
 
 TEST(Restart, ANewRunIntoTheDirectoryDropsTheOldCheckpoint) {
-  // Run A completes (checkpoint); run B into the same directory fails at step
-  // 1 before writing one: a restart must not continue A over B's files.
+  // Run A completes (checkpoint at step 2); run B into the same directory
+  // fails at step 1: the checkpoint there must then be B's (its state after
+  // 0 steps, its overrides), never A's, so a restart continues B over B's files.
   const Case c{"stale", squash, "", 1e-2, 2};
   const std::string dir = fresh("stale");
   ASSERT_EQ(run_bfemp("run " + squash + " " + end_time(c, 2) + " -o " + dir, dir + ".a.log"), 0);
   ASSERT_TRUE(fs::exists(dir + "/checkpoint.h5"));
+  EXPECT_EQ(bfemp::read_checkpoint(dir + "/checkpoint.h5").step, 2);
   EXPECT_EQ(run_bfemp("run " + squash + " --set 'Newton/max iterations=1' -o " + dir, dir + ".b.log"), 3)
       << slurp(dir + ".b.log");
-  EXPECT_FALSE(fs::exists(dir + "/checkpoint.h5"));
-  EXPECT_EQ(run_bfemp("restart " + dir, dir + ".r.log"), 2) << slurp(dir + ".r.log");
+  const bfemp::Checkpoint ck = bfemp::read_checkpoint(dir + "/checkpoint.h5");
+  EXPECT_EQ(ck.step, 0);
+  EXPECT_NE(ck.text("overrides").find("Newton/max iterations=1"), std::string::npos) << ck.text("overrides");
+  EXPECT_EQ(run_bfemp("restart " + dir + " --set 'Newton/max iterations=300' " + end_time(c, 2), dir + ".r.log"), 0)
+      << slurp(dir + ".r.log");
+  EXPECT_EQ(bfemp::read_checkpoint(dir + "/checkpoint.h5").step, 2);
 }
 
 TEST(Restart, AChangedMeshFileIsRefused) {
@@ -460,4 +468,35 @@ TEST(Restart, AChangedMeshFileIsRefused) {
   std::ofstream(work + "/square.msh") << msh;
   EXPECT_EQ(run_bfemp("restart " + dir + " --set 'Time/end time=0.045'", dir + ".r2.log"), 2) << slurp(dir + ".r2.log");
   EXPECT_NE(slurp(dir + ".r2.log").find("FEM mesh differs"), std::string::npos) << slurp(dir + ".r2.log");
+}
+
+// A solver failure (here Newton over a cap of 15 iterations at the disk's
+// impact on the wall) exits 3 naming the step, after checkpointing the state
+// of the last completed step; restarting from it with a higher cap gives the
+// run that had that cap from the start, bit for bit.
+TEST(Restart, ASolverFailureCheckpointsTheLastCompletedStep) {
+  const Case c{"failure", disk_wall, friction_sets, 1e-3, 6};
+  const std::string full = fresh("failure_full"), failed = fresh("failure_failed");
+  const std::string high = " --set 'Newton/max iterations=300'";
+  EXPECT_EQ(run_bfemp("run " + c.scene + " " + c.sets + high + " " + end_time(c, 2 * c.n) + " -o " + full,
+                      full + ".log"),
+            0)
+      << slurp(full + ".log");
+  EXPECT_EQ(run_bfemp("run " + c.scene + " " + c.sets + " --set 'Newton/max iterations=15' " + end_time(c, 2 * c.n) +
+                          " -o " + failed,
+                      failed + ".log"),
+            3)
+      << slurp(failed + ".log");
+  const std::string log = slurp(failed + ".log");
+  EXPECT_NE(log.find("solver failure at step"), std::string::npos) << log;
+  EXPECT_NE(log.find("is checkpointed"), std::string::npos) << log;
+  EXPECT_NE(log.find("bfemp restart " + failed), std::string::npos) << log;
+  const bfemp::Checkpoint ck = bfemp::read_checkpoint(failed + "/checkpoint.h5");
+  EXPECT_GE(ck.step, 1) << "the cap should let the first step through";
+  EXPECT_LT(ck.step, 2 * c.n);
+  EXPECT_NE(log.find("step " + std::to_string(ck.step + 1) + " "), std::string::npos) << log;
+  EXPECT_EQ(run_bfemp("restart " + failed + high + " " + end_time(c, 2 * c.n), failed + ".restart.log"), 0)
+      << slurp(failed + ".restart.log");
+  expect_same_checkpoint(full, failed);
+  expect_same_diagnostics(full, failed);
 }
