@@ -248,6 +248,9 @@ void build_mpm(const Scene& scene, const std::vector<std::string>& mat_names, Si
     const std::string type = l.get<std::string>("type");
     ls.kind = type == "box" ? LevelSetKind::Box : type == "sine" ? LevelSetKind::Sine : LevelSetKind::HalfPlane;
     ls.slip = l.get<bool>("slip");
+    const double until = l.get<double>("until");
+    if (!(until >= 0) || !std::isfinite(until)) bad(key + "/until", num(until), "a finite time >= 0 (s; 0: never removed)");
+    if (until > 0) ls.until = until;
     ls.velocity = vec3(l.get<Array<double>>("velocity"), dim, key + "/velocity");
     const auto& motion = l.sublist("Motion");
     if (motion.numParams() > 0 && !l.get<Array<double>>("velocity").empty())

@@ -105,6 +105,7 @@ ParameterList level_set_schema() {
   l.set("wavelength", 0.0, "sine: wavelength (m), > 0 for type sine");
   choice(l, "solid", "below", "sine: the solid side of the contour", tuple<std::string>("below", "above"));
   l.set("velocity", Array<double>(), "m/s, constant motion of the boundary (default 0)");
+  l.set("until", 0.0, "s: the level set is removed at this time, > 0 (0: never)");
   l.sublist("Motion", false,
             "piecewise motion instead of velocity: segments of type velocity or fixed, in name order; "
             "at rest after the last")

@@ -28,6 +28,11 @@ struct LevelSet {
   std::array<double, 3> normal{0, 1, 0};    // half-plane: unit normal into the free side
   std::array<double, 3> box_min{0, 0, 0}, box_max{0, 0, 0};
   std::array<double, 3> velocity{0, 0, 0};  // m/s, constant (when segments == 0)
+  // Removed at this time (s): in the steps that start at t >= until (to a
+  // relative 1e-9, as t accumulates dt) no node is inside and no particle
+  // counts as penetrating (A4's support plane, taken away after the box has
+  // settled). 1e300: never.
+  double until = 1e300;
   // Piecewise-constant motion: velocity seg_velocity[k] until seg_end[k] (s,
   // increasing), at rest after the last.
   static constexpr int kMaxSegments = 8;
@@ -61,6 +66,7 @@ struct LevelSet {
   // (y - y_c(x)) / |grad (y - y_c(x))|).
   template <int dim>
   KOKKOS_INLINE_FUNCTION double phi(const Vec<dim>& x, double t) const {
+    if (t >= until * (1.0 - 1e-9)) return 1e300;  // removed (1e-9: t is a sum of time steps)
     if (kind == LevelSetKind::HalfPlane) {
       double s = 0;
       for (int d = 0; d < dim; ++d) s += (x(d) - point[d] - offset(d, t)) * normal[d];

@@ -205,3 +205,35 @@ TEST(MpmSlipSine, SlipSlidesDownTheFlankNoSlipHolds) {
   EXPECT_GT(min_phi_slip, 0.0) << "a particle passed the sine contour";
   EXPECT_LT(violation, 1e-13);
 }
+
+// Level Sets/<name>/until: a no-slip floor holds a block until t = 0.1 s and
+// is then removed: the block rests on it (its centre of mass moves < 1e-3 m)
+// and from then on falls freely: with no constraint left, the particles'
+// centre of mass follows backward Euler's free-fall recurrence
+// v += -g dt, y += dt v to round-off (the transfers keep the mass-weighted
+// mean velocity), starting from the centre-of-mass velocity at removal.
+TEST(MpmLevelSetUntil, RemovedFloorReleasesTheBlockIntoFreeFall) {
+  auto s = mpm_rect_setup(0.2, 0.1, Vec<2>(0.0, 0.05), 0.025, 4, Vec<2>(-0.6, -0.6), Vec<2>(0.6, 0.6),
+                          TransferScheme::APIC, 1e6, 0.3, 1000.0);
+  s.gravity = {0.0, -g, 0.0};
+  s.dt = 0.01;
+  LevelSet floor;  // solid below y = 0
+  floor.normal = {0.0, 1.0, 0.0};
+  floor.until = 0.1;
+  s.level_sets.push_back(floor);
+  Simulation<2> sim(s, fixtures::comm());
+  const auto& p = sim.mpm()->particles();
+  const double y0 = particle_mean(p, 1);
+  while (sim.time() < 0.1 - 1e-12) sim.step();
+  EXPECT_LT(std::abs(particle_mean(p, 1) - y0), 1e-3) << "the floor holds the block until it is removed";
+  double mass = 0;
+  double y = particle_mean(p, 1), v = particle_momentum(p, mass)[1] / mass;
+  for (int k = 0; k < 10; ++k) {
+    sim.step();
+    v -= g * s.dt;
+    y += s.dt * v;
+  }
+  EXPECT_NEAR(particle_mean(p, 1), y, 1e-10);
+  EXPECT_NEAR(particle_momentum(p, mass)[1] / mass, v, 1e-10);
+  EXPECT_LT(y, y0 - 0.04) << "it fell";
+}

@@ -276,3 +276,23 @@ TEST(SceneInput, TheA6SceneBuildsWithFemFemContact) {
   EXPECT_EQ(setup.contact->mu[(1 + 0) * 2 + 1], 10.0);
   EXPECT_EQ(setup.contact->mu[0 * 2 + 0], 0.0);  // inner : outer
 }
+
+// Level Sets/<name>/until: > 0 removes the level set at that time, 0 never;
+// negative or non-finite values are refused naming the key.
+TEST(SceneInput, LevelSetUntil) {
+  const std::string column = std::string(BFEMP_SOURCE_DIR) + "/inputs/mpm_column.yaml";
+  auto until_of = [&](const std::vector<std::string>& sets) {
+    const auto setup = build_setup<2>(load_scene(column, sets));
+    return setup.level_sets.at(0).until;
+  };
+  EXPECT_EQ(until_of({}), 1e300);
+  EXPECT_EQ(until_of({"Level Sets/ground/until=0.25"}), 0.25);
+  for (const char* v : {"-1.0", "nan", "inf"}) {
+    try {
+      until_of({std::string("Level Sets/ground/until=") + v});
+      ADD_FAILURE() << "until = " << v << " accepted";
+    } catch (const std::invalid_argument& e) {
+      EXPECT_NE(std::string(e.what()).find("Level Sets/ground/until"), std::string::npos) << e.what();
+    }
+  }
+}
