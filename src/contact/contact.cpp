@@ -280,12 +280,13 @@ typename Contact<dim>::Report Contact<dim>::report(ConstDofView x, LO n_fem_node
     const auto pr = act.pairs;
     const auto pbody = barrier_->primitives().body;
     const int fb = params_.force_body;
+    const LO npart = n_particles_;  // the box of particles only (FEM-FEM points are not particles)
     for (int c = 0; c < dim; ++c) {
       double lo = std::numeric_limits<double>::infinity(), hi = -lo;
       Kokkos::parallel_reduce(
           "contact_extent", Kokkos::RangePolicy<ExecSpace>(0, act.count),
           KOKKOS_LAMBDA(const LO k, double& a, double& b) {
-            if (fb >= 0 && pbody(pr(k, 1)) != fb) return;
+            if (pr(k, 0) >= npart || (fb >= 0 && pbody(pr(k, 1)) != fb)) return;
             const double v = xp(pr(k, 0) * dim + c);
             a = v < a ? v : a;
             b = v > b ? v : b;

@@ -143,6 +143,7 @@ TEST(ContactFemFemScene, BlockComesToRestOnAPlateAndPressesWithItsWeight) {
   EXPECT_LT(std::abs(r.bodies[1].velocity[1]), 1e-4);
   EXPECT_NEAR(r.contact_force[1], -weight, 1e-3 * weight);  // the plate is pushed down
   EXPECT_NEAR(r.contact_force[0], 0.0, 1e-6 * weight);
+  EXPECT_TRUE(std::isnan(r.contact_lo[0])) << "the contact box covers particles only (there are none)";
 }
 
 TEST(ContactFemFemScene, SlidingBlockDeceleratesAtMuG) {
@@ -175,7 +176,7 @@ TEST(ContactFemFemScene, SlidingBlockDeceleratesAtMuG) {
   }
   const double a = (n * stv - st * sv) / (n * stt - st * st);
   std::cout << "  sliding deceleration " << -a << " m/s^2 (mu g = " << mu * 9.81 << ")\n";
-  EXPECT_NEAR(-a, mu * 9.81, 0.01 * mu * 9.81);
+  EXPECT_NEAR(-a, mu * 9.81, 1e-4 * mu * 9.81);  // the slope test's band (A4: 0.01 %)
 }
 
 // VALIDATION A6 at its ci size (inputs/a6_semiring_buckling.yaml), first
