@@ -17,6 +17,7 @@
 
 #include "io/checkpoint.hpp"
 #include "io/scene.hpp"
+#include "solver/blas_threads.hpp"
 #include "probes/probes.hpp"
 #include "sim/interrupt.hpp"
 #include "sim/run.hpp"
@@ -94,10 +95,11 @@ int main(int argc, char** argv) {
     auto comm = Tpetra::getDefaultComm();
     const bool root = comm->getRank() == 0;
     std::ostream& log = std::cout;
+    const std::string blas = bfemp::match_blas_threads(Kokkos::DefaultExecutionSpace::concurrency());
     if (root && !probe->parsed())
       log << "bfemp: Kokkos " << Kokkos::DefaultExecutionSpace::name() << ", "
           << Kokkos::DefaultExecutionSpace::concurrency() << " thread(s); MPI ranks "
-          << comm->getSize() << "\n";
+          << comm->getSize() << "; " << blas << "\n";
     try {
       bfemp::RunOptions opt;
       opt.handle_signals = true;

@@ -8,7 +8,7 @@ cd "$(dirname "$0")/.."
 if [ "$(id -u)" = 0 ]; then scripts/setup.sh; else sudo scripts/setup.sh; fi
 cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release
 cmake --build build -j"$(nproc)" --target bfemp
-OMP_PROC_BIND=${OMP_PROC_BIND:-spread} OMP_PLACES=${OMP_PLACES:-threads} OPENBLAS_NUM_THREADS=1 \
+OMP_PROC_BIND=${OMP_PROC_BIND:-spread} OMP_PLACES=${OMP_PLACES:-threads} \
   ./build/drivers/bfemp run inputs/default_contact.yaml --output out "$@"
 plot="(not drawn: python3-matplotlib missing)"
 if /usr/bin/python3 scripts/plot_diagnostics.py out > /dev/null; then plot=out/diagnostics.png; fi

@@ -28,7 +28,6 @@ bin="$build_dir/drivers/bfemp"
 [[ -x "$bin" ]] || { echo "run_sweeps.sh: $bin not found; build it first" >&2; exit 2; }
 [[ -n "$work" ]] || { work="$(mktemp -d)"; trap 'rm -rf "$work"' EXIT; }
 export OMP_NUM_THREADS=${OMP_NUM_THREADS:-2} OMP_PROC_BIND=${OMP_PROC_BIND:-spread} OMP_PLACES=${OMP_PLACES:-threads}
-export OPENBLAS_NUM_THREADS=1
 out="$repo/validation/sweeps"
 
 sweep() {  # name, then bfemp sweep arguments

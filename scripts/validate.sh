@@ -8,5 +8,5 @@ set -euo pipefail
 repo="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 py=/usr/bin/python3   # Debian's, with python3-matplotlib
 [[ -x "$py" ]] || py=python3
-export OMP_PROC_BIND=${OMP_PROC_BIND:-spread} OMP_PLACES=${OMP_PLACES:-threads} OPENBLAS_NUM_THREADS=1
+export OMP_PROC_BIND=${OMP_PROC_BIND:-spread} OMP_PLACES=${OMP_PLACES:-threads}
 exec "$py" "$repo/scripts/validate.py" "$@"
