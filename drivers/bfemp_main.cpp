@@ -95,7 +95,7 @@ int main(int argc, char** argv) {
     auto comm = Tpetra::getDefaultComm();
     const bool root = comm->getRank() == 0;
     std::ostream& log = std::cout;
-    const std::string blas = bfemp::match_blas_threads(Kokkos::DefaultExecutionSpace::concurrency());
+    const std::string blas = bfemp::configure_blas_threads();
     if (root && !probe->parsed())
       log << "bfemp: Kokkos " << Kokkos::DefaultExecutionSpace::name() << ", "
           << Kokkos::DefaultExecutionSpace::concurrency() << " thread(s); MPI ranks "

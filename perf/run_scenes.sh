@@ -32,7 +32,7 @@ bin="$build_dir/drivers/bfemp"
 [[ -x "$bin" ]] || { echo "run_scenes.sh: $bin not found; build it first: ninja -C $build_dir bfemp" >&2; exit 2; }
 tmp="$(mktemp -d)"
 trap 'rm -rf "$tmp"' EXIT
-export OMP_PROC_BIND=spread OMP_PLACES=threads  # bfemp gives the BLAS its Kokkos thread count
+export OMP_PROC_BIND=spread OMP_PLACES=threads  # bfemp runs the BLAS on one thread
 end_time=$(python3 -c "print(($steps + 0.5) * 2e-4)")
 runs=()
 for t in $threads; do

@@ -19,13 +19,13 @@ int blas_threads() {
   return get ? get() : 0;
 }
 
-std::string match_blas_threads(int threads) {
+std::string configure_blas_threads() {
   const SetThreads set = set_fn();
   if (!set || !get_fn()) return "BLAS: not OpenBLAS (its threads left as they are)";
   const char* user = std::getenv("OPENBLAS_NUM_THREADS");
   if (user && *user) return "BLAS: OpenBLAS, " + std::to_string(blas_threads()) + " thread(s) (OPENBLAS_NUM_THREADS)";
-  if (threads >= 1) set(threads);
-  return "BLAS: OpenBLAS, " + std::to_string(blas_threads()) + " thread(s) (as Kokkos)";
+  set(1);
+  return "BLAS: OpenBLAS, " + std::to_string(blas_threads()) + " thread(s)";
 }
 
 }  // namespace bfemp
