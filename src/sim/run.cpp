@@ -148,6 +148,7 @@ void accumulate(RunSummary& s, const StepReport& r) {
   s.contact_eval_s += r.contact_eval_s;
   s.contact_ccd_s += r.contact_ccd_s;
   s.symbolic_factorizations += r.newton.symbolic_factorizations;
+  s.numeric_factorizations += r.newton.numeric_factorizations;
   s.exact_hessian_iterations += r.newton.exact_hessian_iterations;
   s.projection_fallbacks += r.newton.projection_fallbacks;
 }
@@ -337,6 +338,9 @@ RunSummary run_scene(const Scene& scene, const std::string& dir, const Teuchos::
   log << "  graph builds        " << s.graph_builds << " (symbolic factorisations " << s.symbolic_factorizations
       << ")\n"
       << "  linear-solve time   " << s.solve_s << " s\n";
+  if (s.numeric_factorizations > 0)
+    log << "  factorisations      " << s.numeric_factorizations << " numeric, for " << s.newton_iterations
+        << " Newton iterations (the others: CG on the previous factor)\n";
   if (s.exact_hessian_iterations + s.projection_fallbacks > 0)
     log << "  exact Hessian       " << s.exact_hessian_iterations << " of " << s.newton_iterations
         << " iterations (" << s.projection_fallbacks << " not positive definite: projected)\n";

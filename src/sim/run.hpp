@@ -24,7 +24,7 @@ struct RunSummary {
   double contact_broad_phase_s = 0, contact_eval_s = 0, contact_ccd_s = 0;  // parts of the above
   int frames = 0;
   int checkpoints = 0;
-  long graph_builds = 0, symbolic_factorizations = 0;
+  long graph_builds = 0, symbolic_factorizations = 0, numeric_factorizations = 0;
   long exact_hessian_iterations = 0, projection_fallbacks = 0;  // Newton/hessian: exact-if-definite
   std::vector<std::pair<std::string, double>> term_assembly_s;  // per energy term
 };

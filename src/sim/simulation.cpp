@@ -240,6 +240,7 @@ StepReport Simulation<dim>::step() {
   Kokkos::Timer timer;
   const double dt = setup_.dt;
   const double t1 = time_ + dt;
+  newton_->new_time_step();
   const TimeIntegrator& ti = setup_.integrator;
   const double h = ti.potential_scale(dt);
   const double ca = ti.predictor_acc_scale(dt);
@@ -462,6 +463,7 @@ NewtonStats Simulation<dim>::minimize_with_friction(const IncrementalPotential& 
     total.min_step = std::min(total.min_step, st.min_step);
     total.graph_builds += st.graph_builds;
     total.symbolic_factorizations += st.symbolic_factorizations;
+    total.numeric_factorizations += st.numeric_factorizations;
     total.exact_hessian_iterations += st.exact_hessian_iterations;
     total.projection_fallbacks += st.projection_fallbacks;
     if (iterations > 1 && st.iterations == 1) break;  // converged at the lagged update

@@ -3,6 +3,7 @@
 #include <Tpetra_CrsMatrix.hpp>
 #include <Tpetra_Vector.hpp>
 #include <cholmod.h>
+#include <cmath>
 #include <cstring>
 #include <string>
 #include <vector>
@@ -37,8 +38,12 @@ struct CholmodDirect::Impl {
   Teuchos::RCP<const Matrix> A;
   std::vector<SuiteSparse_long> p, i;  // CHOLMOD's index type; built once per graph
   bool analysed = false;
+  bool factor_ok = false;  // L holds a complete numeric factor of this graph
+  Reuse reuse;
+  using V = Kokkos::View<double*, MemSpace>;
+  V cg_x, cg_r, cg_z, cg_p, cg_q;  // CG work, sized once per graph
 
-  Impl() {
+  explicit Impl(Reuse r) : reuse(r) {
     cholmod_l_start(&c);
     c.print = 0;
     c.error_handler = nullptr;  // errors come back as c.status
@@ -69,7 +74,7 @@ struct CholmodDirect::Impl {
   }
 };
 
-CholmodDirect::CholmodDirect() : impl_(new Impl) {}
+CholmodDirect::CholmodDirect(Reuse reuse) : impl_(new Impl(reuse)) {}
 CholmodDirect::~CholmodDirect() = default;
 
 void CholmodDirect::set_matrix(const Teuchos::RCP<const Matrix>& A) {
@@ -83,11 +88,122 @@ void CholmodDirect::set_matrix(const Teuchos::RCP<const Matrix>& A) {
   for (std::size_t k = 0; k < m.i.size(); ++k) m.i[k] = lcl.graph.entries(k);
   if (m.L) cholmod_l_free_factor(&m.L, &m.c);
   m.analysed = false;
+  m.factor_ok = false;
+  if (m.reuse.max_iterations > 0 && m.cg_x.extent(0) != n) {
+    m.cg_x = Impl::V("cholmod_cg_x", n);
+    m.cg_r = Impl::V("cholmod_cg_r", n);
+    m.cg_z = Impl::V("cholmod_cg_z", n);
+    m.cg_p = Impl::V("cholmod_cg_p", n);
+    m.cg_q = Impl::V("cholmod_cg_q", n);
+  }
 }
 
-bool CholmodDirect::solve(const Vector& b, Vector& x) {
+void CholmodDirect::forget_factor() { impl_->factor_ok = false; }
+
+namespace {
+using Range = Kokkos::RangePolicy<ExecSpace>;
+
+double dot(const Kokkos::View<double*, MemSpace>& a, const Kokkos::View<double*, MemSpace>& b) {
+  double s = 0;
+  Kokkos::parallel_reduce(
+      "cholmod_cg_dot", Range(0, a.extent(0)), KOKKOS_LAMBDA(const std::size_t k, double& acc) { acc += a(k) * b(k); }, s);
+  return s;
+}
+}  // namespace
+
+// CG on A x = b preconditioned by the stored factor; true when it reached the
+// tolerance (x then in m.cg_x). `its` counts the iterations run.
+static bool cg_on_old_factor(CholmodDirect::Reuse reuse, cholmod_common& c, cholmod_factor* L, cholmod_dense*& X,
+                             cholmod_dense*& Y, cholmod_dense*& E, const Matrix& A, const Vector& b,
+                             Kokkos::View<double*, MemSpace> x, Kokkos::View<double*, MemSpace> r,
+                             Kokkos::View<double*, MemSpace> z, Kokkos::View<double*, MemSpace> p,
+                             Kokkos::View<double*, MemSpace> q, int& its) {
+  const auto lcl = A.getLocalMatrixDevice();
+  const auto rows = lcl.graph.row_map;
+  const auto cols = lcl.graph.entries;
+  const auto vals = lcl.values;
+  const std::size_t n = x.extent(0);
+  const auto bv = b.getLocalViewDevice(Tpetra::Access::ReadOnly);
+  Kokkos::parallel_for(
+      "cholmod_cg_init", Range(0, n), KOKKOS_LAMBDA(const std::size_t k) {
+        x(k) = 0.0;
+        r(k) = bv(k, 0);
+      });
+  const double bn = std::sqrt(dot(r, r));
+  its = 0;
+  if (bn == 0.0) return true;
+  const double stop = reuse.tolerance * bn;
+  auto precondition = [&]() {  // z = (L L^T)^-1 r
+    cholmod_dense R{};
+    R.nrow = n;
+    R.ncol = 1;
+    R.nzmax = n;
+    R.d = n;
+    R.x = r.data();
+    R.xtype = CHOLMOD_REAL;
+    R.dtype = CHOLMOD_DOUBLE;
+    if (!cholmod_l_solve2(CHOLMOD_A, L, &R, nullptr, &X, nullptr, &Y, &E, &c) || c.status != CHOLMOD_OK) return false;
+    const double* xs = static_cast<const double*>(X->x);
+    Kokkos::parallel_for("cholmod_cg_z", Range(0, n), KOKKOS_LAMBDA(const std::size_t k) { z(k) = xs[k]; });
+    return true;
+  };
+  if (!precondition()) return false;
+  Kokkos::deep_copy(p, z);
+  double rz = dot(r, z);
+  for (its = 1; its <= reuse.max_iterations; ++its) {
+    Kokkos::parallel_for(
+        "cholmod_cg_spmv", Range(0, n), KOKKOS_LAMBDA(const std::size_t i) {
+          double acc = 0;
+          for (auto k = rows(i); k < rows(i + 1); ++k) acc += vals(k) * p(cols(k));
+          q(i) = acc;
+        });
+    const double pq = dot(p, q);
+    if (!(pq > 0.0) || !(rz > 0.0)) return false;  // non-positive curvature: let the factorisation decide
+    const double alpha = rz / pq;
+    double rr = 0;
+    Kokkos::parallel_reduce(
+        "cholmod_cg_update", Range(0, n),
+        KOKKOS_LAMBDA(const std::size_t k, double& acc) {
+          x(k) += alpha * p(k);
+          r(k) -= alpha * q(k);
+          acc += r(k) * r(k);
+        },
+        rr);
+    const double rn = std::sqrt(rr);
+    if (!std::isfinite(rn)) return false;
+    if (rn <= stop) return true;
+    // Too slow to arrive within the cap at the mean rate so far: factorise.
+    if (its >= 4 && its < reuse.max_iterations) {
+      const double rate = std::pow(rn / bn, 1.0 / its);
+      if (rate >= 1.0 || its + std::log(stop / rn) / std::log(rate) > reuse.max_iterations) return false;
+    }
+    if (its == reuse.max_iterations) break;
+    if (!precondition()) return false;
+    const double rz1 = dot(r, z);
+    const double beta = rz1 / rz;
+    rz = rz1;
+    Kokkos::parallel_for("cholmod_cg_dir", Range(0, n), KOKKOS_LAMBDA(const std::size_t k) { p(k) = z(k) + beta * p(k); });
+  }
+  its = std::min(its, reuse.max_iterations);
+  return false;
+}
+
+CholmodDirect::Result CholmodDirect::solve(const Vector& b, Vector& x) {
   auto& m = *impl_;
   if (m.A.is_null()) throw std::logic_error("CholmodDirect::solve before set_matrix");
+  Result res;
+  if (m.factor_ok && m.reuse.max_iterations > 0) {
+    const bool ok = cg_on_old_factor(m.reuse, m.c, m.L, m.X, m.Y, m.E, *m.A, b, m.cg_x, m.cg_r, m.cg_z, m.cg_p,
+                                     m.cg_q, res.cg_iterations);
+    if (ok) {
+      auto xv = x.getLocalViewDevice(Tpetra::Access::OverwriteAll);
+      const auto cx = m.cg_x;
+      Kokkos::parallel_for("cholmod_cg_out", Kokkos::RangePolicy<ExecSpace>(0, cx.extent(0)),
+                           KOKKOS_LAMBDA(const std::size_t k) { xv(k, 0) = cx(k); });
+      Kokkos::fence();
+      return res;
+    }
+  }
   cholmod_sparse S = m.view();
   bool analysed_now = false;
   if (!m.analysed) {
@@ -97,11 +213,15 @@ bool CholmodDirect::solve(const Vector& b, Vector& x) {
     m.analysed = true;
     analysed_now = true;
   }
+  m.factor_ok = false;
+  res.analysed = analysed_now;
+  res.factorised = true;
   if (!cholmod_l_factorize(&S, m.L, &m.c) || m.c.status != CHOLMOD_OK) {
     if (m.c.status == CHOLMOD_NOT_POSDEF)
       throw NotPositiveDefinite("Cholmod factorisation failed: " + status_name(m.c.status));
     throw SolverError("Cholmod factorisation failed: " + status_name(m.c.status));
   }
+  m.factor_ok = true;
   auto bv = b.getLocalViewDevice(Tpetra::Access::ReadOnly);
   cholmod_dense B{};
   B.nrow = S.nrow;
@@ -115,7 +235,7 @@ bool CholmodDirect::solve(const Vector& b, Vector& x) {
     throw SolverError("Cholmod solve failed: " + status_name(m.c.status));
   auto xv = x.getLocalViewDevice(Tpetra::Access::OverwriteAll);
   std::memcpy(xv.data(), m.X->x, S.nrow * sizeof(double));
-  return analysed_now;
+  return res;
 }
 
 }  // namespace bfemp

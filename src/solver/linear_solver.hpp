@@ -15,9 +15,11 @@ namespace bfemp {
 enum class LinearSolverKind { Cholmod, KLU2, CG };
 
 struct LinearSolveStats {
-  int iterations = 0;        // Krylov iterations (1 for a direct solve)
+  int iterations = 0;        // Krylov iterations (1 for a direct solve; Cholmod: CG
+                             // iterations on the previous factor, + 1 if it factorised)
   double achieved_tol = 0;   // relative residual reported by the solver
   bool refactored = false;   // a symbolic factorisation happened in this call
+  bool factorised = false;   // a numeric factorisation happened in this call (direct solvers)
   double tolerance = 0;      // relative residual the solve was asked for (0: direct)
 };
 
@@ -44,6 +46,9 @@ class LinearSolver {
   // `forcing` > 0 (CG with 'forcing term: adaptive'): the relative residual
   // to reach, clamped to [tolerance, 0.1]; direct solvers ignore it.
   LinearSolveStats solve(const Vector& b, Vector& x, double forcing = 0.0);
+  // Cholmod: the next solve factorises instead of reusing the previous factor
+  // (called at the start of each time step); a no-op for the others.
+  void forget_factor();
 
   // MueLu: the caller should pass the rigid-body modes of the DOFs' nodes
   // (rigid_body_modes in solver/muelu_preconditioner.hpp) after every

@@ -150,6 +150,11 @@ const DofSpace<dim>& NewtonSolver<dim>::dof_space() const {
 }
 
 template <int dim>
+void NewtonSolver<dim>::new_time_step() {
+  impl_->solver.forget_factor();
+}
+
+template <int dim>
 const LinearSolver& NewtonSolver<dim>::linear_solver() const {
   return impl_->solver;
 }
@@ -268,6 +273,7 @@ NewtonStats NewtonSolver<dim>::minimize(const IncrementalPotential& ip, View1 x)
       // The exact Hessian is indefinite here: the projected one for this iteration.
       st.solve_s += timer.seconds();
       ++st.projection_fallbacks;
+      ++st.numeric_factorizations;  // the one that failed
       project = true;
       timer.reset();
       m.assemble(ip, x, project);
@@ -280,6 +286,7 @@ NewtonStats NewtonSolver<dim>::minimize(const IncrementalPotential& ip, View1 x)
     if (!project) ++st.exact_hessian_iterations;
     st.linear_iterations += ls.iterations;
     if (ls.refactored) ++st.symbolic_factorizations;
+    if (ls.factorised) ++st.numeric_factorizations;
     m.dofs.to_local(*m.p, dir);
     st.solve_s += timer.seconds();
 

@@ -48,6 +48,7 @@ struct NewtonStats {
   double min_step = 1.0;   // smallest accepted line-search step
   int graph_builds = 0;            // graph rebuilds inside the solve (contact pairs outside the graph)
   int symbolic_factorizations = 0; // direct solvers: symbolic phases run
+  int numeric_factorizations = 0;  // direct solvers: numeric factorisations run (failed ones too)
   int exact_hessian_iterations = 0; // iterations solved with the exact Hessian
   int projection_fallbacks = 0;     // exact Hessian not positive definite: projected instead
 };
@@ -88,6 +89,11 @@ class NewtonSolver {
   // when the node count or a term's couplings changed; returns true then. The
   // terms must outlive the next minimize().
   bool set_system(LO n_nodes, std::vector<const EnergyTerm<dim>*> terms);
+
+  // A new time step: the linear solver's next solve factorises (Cholmod
+  // reuses a factor only within one step, so a restarted run takes the same
+  // path as the run it continues).
+  void new_time_step();
 
   // Minimises E from the initial guess in `x` (overwritten with the result).
   // Throws SolverError when the linear solve fails, the line search stalls or

@@ -142,6 +142,14 @@ TEST(SceneErrors, BadEnumAndSolverKeys) {
   expect_message(error_of(scene_with("preconditioner: CHEBYSHEV",
                                      "preconditioner: CHEBYSHEV\n      Ifpack2:\n        'chebyshev: degre': 3")),
                  {"chebyshev: degre", "CHEBYSHEV"});
+  // Cholmod's reuse keys: ignored by CG, so refused with it; out of range refused by the schema.
+  expect_message(error_of(scene_with("type: CG", "type: CG\n    Cholmod:\n      reuse iterations: 5")),
+                 {"Linear Solver/Cholmod", "CG", "type Cholmod"});
+  expect_message(error_of(scene_with("type: CG", "type: Cholmod\n    Cholmod:\n      reuse iterations: -1")),
+                 {"reuse iterations", "-1"});
+  expect_message(error_of(scene_with("type: CG", "type: Cholmod\n    Cholmod:\n      reuse tolerance: 0.1")),
+                 {"reuse tolerance", "0.1"});
+  EXPECT_EQ(error_of(scene_with("type: CG", "type: Cholmod\n    Cholmod:\n      reuse iterations: 0")), "");
 }
 
 TEST(SceneErrors, UnknownNodeSetAndMaterial) {

@@ -1,0 +1,202 @@
+// Cholmod's factor reuse (solver/cholmod_direct.hpp): CG preconditioned by the
+// previous numeric factor of the same graph, or a new factorisation when CG
+// cannot reach the tolerance, meets non-positive curvature, or the factor was
+// forgotten. Matrices: the 2D five-point Laplacian on a 20 x 20 grid plus a
+// diagonal shift (full symmetric storage, as the DOF space assembles it).
+#include <gtest/gtest.h>
+
+#include <Tpetra_CrsMatrix.hpp>
+#include <Tpetra_Vector.hpp>
+#include <cmath>
+#include <random>
+#include <vector>
+
+#include "common/fem_fixtures.hpp"
+#include "solver/cholmod_direct.hpp"
+#include "solver/solver_error.hpp"
+
+namespace {
+
+using namespace bfemp;
+using Teuchos::RCP;
+using Teuchos::rcp;
+
+constexpr int kSide = 20, kN = kSide * kSide;
+
+// Laplacian + diag(shift_i); the graph is the same for every shift.
+RCP<Matrix> laplacian(const std::vector<double>& shift) {
+  auto map = rcp(new Map(kN, 0, fixtures::comm()));
+  auto A = rcp(new Matrix(map, 5));
+  for (int i = 0; i < kN; ++i) {
+    const int r = i / kSide, c = i % kSide;
+    std::vector<GO> cols{i};
+    std::vector<double> vals{4.0 + shift[i]};
+    if (c > 0) cols.push_back(i - 1), vals.push_back(-1.0);
+    if (c + 1 < kSide) cols.push_back(i + 1), vals.push_back(-1.0);
+    if (r > 0) cols.push_back(i - kSide), vals.push_back(-1.0);
+    if (r + 1 < kSide) cols.push_back(i + kSide), vals.push_back(-1.0);
+    A->insertGlobalValues(GO(i), Teuchos::ArrayView<const GO>(cols), Teuchos::ArrayView<const double>(vals));
+  }
+  A->fillComplete();
+  return A;
+}
+
+// Overwrites A's values with those of B (same graph): the solver keeps A.
+void copy_values(const Matrix& B, Matrix& A) {
+  A.resumeFill();
+  auto a = A.getLocalMatrixDevice().values;
+  auto b = B.getLocalMatrixDevice().values;
+  Kokkos::deep_copy(a, b);
+  A.fillComplete();
+}
+
+double relative_residual(const Matrix& A, const Vector& x, const Vector& b) {
+  Vector r(b.getMap());
+  A.apply(x, r);
+  r.update(1.0, b, -1.0);
+  return r.norm2() / b.norm2();
+}
+
+struct Fixture {
+  std::vector<double> shift = std::vector<double>(kN, 1.0);
+  RCP<Matrix> A = laplacian(shift);
+  Vector b{A->getRowMap()}, x{A->getRowMap()};
+  Fixture() { b.randomize(); }
+};
+
+TEST(CholmodReuse, NearbyValuesAreSolvedByCgOnThePreviousFactor) {
+  Fixture f;
+  CholmodDirect solver(CholmodReuse{20, 1e-10});
+  solver.set_matrix(f.A);
+  const auto first = solver.solve(f.b, f.x);
+  EXPECT_TRUE(first.analysed);
+  EXPECT_TRUE(first.factorised);
+  EXPECT_EQ(first.cg_iterations, 0);
+  EXPECT_LT(relative_residual(*f.A, f.x, f.b), 1e-13);
+
+  // A Newton-like change: the shift moves by up to 5 %.
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> u(-0.05, 0.05);
+  auto s2 = f.shift;
+  for (double& s : s2) s *= 1.0 + u(rng);
+  copy_values(*laplacian(s2), *f.A);
+  const auto second = solver.solve(f.b, f.x);
+  EXPECT_FALSE(second.factorised);
+  EXPECT_FALSE(second.analysed);
+  EXPECT_GE(second.cg_iterations, 1);
+  EXPECT_LE(second.cg_iterations, 20);
+  EXPECT_LT(relative_residual(*f.A, f.x, f.b), 1e-10);
+
+  // The same system factorised anew gives the same x to the CG tolerance.
+  CholmodDirect direct(CholmodReuse{0, 1e-10});
+  direct.set_matrix(f.A);
+  Vector xd(f.A->getRowMap());
+  EXPECT_TRUE(direct.solve(f.b, xd).factorised);
+  Vector d(f.A->getRowMap());
+  d.update(1.0, f.x, -1.0, xd, 0.0);
+  EXPECT_LT(d.norm2() / xd.norm2(), 1e-9);
+
+  // forget_factor (a new time step): the next solve factorises.
+  solver.forget_factor();
+  const auto third = solver.solve(f.b, f.x);
+  EXPECT_TRUE(third.factorised);
+  EXPECT_EQ(third.cg_iterations, 0);
+}
+
+TEST(CholmodReuse, FarValuesAreFactorisedAnew) {
+  Fixture f;
+  CholmodDirect solver(CholmodReuse{20, 1e-10});
+  solver.set_matrix(f.A);
+  solver.solve(f.b, f.x);
+  // Shifts spread over six decades: the old factor is a poor preconditioner.
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> u(-3.0, 3.0);
+  auto s2 = f.shift;
+  for (double& s : s2) s = std::pow(10.0, u(rng));
+  copy_values(*laplacian(s2), *f.A);
+  const auto r = solver.solve(f.b, f.x);
+  EXPECT_TRUE(r.factorised);
+  EXPECT_GE(r.cg_iterations, 1);  // it tried, and gave up
+  EXPECT_LE(r.cg_iterations, 20);
+  EXPECT_LT(relative_residual(*f.A, f.x, f.b), 1e-12);
+}
+
+TEST(CholmodReuse, AnIndefiniteMatrixIsReportedNotSolvedByCg) {
+  Fixture f;
+  CholmodDirect solver(CholmodReuse{20, 1e-10});
+  solver.set_matrix(f.A);
+  solver.solve(f.b, f.x);
+  // Laplacian eigenvalues lie in (0, 8): a shift of -6 makes it indefinite.
+  copy_values(*laplacian(std::vector<double>(kN, -6.0)), *f.A);
+  EXPECT_THROW(solver.solve(f.b, f.x), NotPositiveDefinite);
+  // The failed factorisation leaves no factor to reuse: the next solve
+  // (definite again) factorises.
+  copy_values(*laplacian(f.shift), *f.A);
+  const auto r = solver.solve(f.b, f.x);
+  EXPECT_TRUE(r.factorised);
+  EXPECT_EQ(r.cg_iterations, 0);
+  EXPECT_LT(relative_residual(*f.A, f.x, f.b), 1e-13);
+}
+
+TEST(CholmodReuse, ZeroIterationsFactorisesEverySolve) {
+  Fixture f;
+  CholmodDirect solver(CholmodReuse{0, 1e-10});
+  solver.set_matrix(f.A);
+  for (int k = 0; k < 3; ++k) {
+    const auto r = solver.solve(f.b, f.x);
+    EXPECT_TRUE(r.factorised);
+    EXPECT_EQ(r.analysed, k == 0);
+    EXPECT_EQ(r.cg_iterations, 0);
+  }
+}
+
+}  // namespace
+
+#include "common/mpm_fixtures.hpp"
+#include "sim/simulation.hpp"
+
+namespace {
+
+// A soft MPM block falling and spinning (several Newton iterations per step):
+// with reuse the run takes fewer numeric factorisations and follows the same
+// trajectory to the solver tolerance (the Newton iteration counts are equal).
+TEST(CholmodReuse, SceneRunsTheSameTrajectoryWithFewerFactorisations) {
+  auto run = [](int reuse, long& factorisations, std::vector<int>& its) {
+    auto s = fixtures::mpm_block_setup(0.3, Vec<2>(0.5, 0.6), 0.05, 4, 0.0, 1.0, TransferScheme::APIC, 2e4);
+    s.dt = 2e-2;
+    s.gravity = {0.0, -9.81, 0.0};
+    s.newton.eps_d = 1e-9;
+    s.linear_solver.sublist("Cholmod").set("reuse iterations", reuse);
+    auto& p = s.mpm->particles;
+    for (std::size_t q = 0; q < p.v.extent(0); ++q) {  // spin about the centre: 3 rad/s
+      p.v(q, 0) = -3.0 * (p.x(q, 1) - 0.6);
+      p.v(q, 1) = 3.0 * (p.x(q, 0) - 0.5);
+    }
+    Simulation<2> sim(s, fixtures::comm());
+    factorisations = 0;
+    for (int k = 0; k < 6; ++k) {
+      const auto r = sim.step();
+      factorisations += r.newton.numeric_factorizations;
+      its.push_back(r.newton.iterations);
+    }
+    return Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), sim.mpm()->particles().x);
+  };
+  long f0 = 0, f20 = 0;
+  std::vector<int> it0, it20;
+  const auto x0 = run(0, f0, it0);
+  const auto x20 = run(20, f20, it20);
+  EXPECT_EQ(it0, it20);
+  long newton = 0;
+  for (int i : it0) newton += i;
+  EXPECT_EQ(f0, newton);
+  EXPECT_LT(f20, f0);
+  EXPECT_GE(f20, 6);  // the first solve of every step factorises
+  double worst = 0;
+  for (std::size_t q = 0; q < x0.extent(0); ++q)
+    for (int c = 0; c < 2; ++c) worst = std::fmax(worst, std::fabs(x0(q, c) - x20(q, c)));
+  EXPECT_LT(worst, 1e-10) << "m";
+  std::printf("  Newton iterations %ld; numeric factorisations %ld (reuse 0) / %ld (reuse 20); max |dx| %.2e m\n",
+              newton, f0, f20, worst);
+}
+
+}  // namespace
