@@ -63,7 +63,9 @@ void BarrierTerm<dim>::begin_step(const ParticleStencils<dim>& ps, ConstDofView 
     xq_ = Kokkos::View<double*, MemSpace>("contact_xq", n);
     dq_ = Kokkos::View<double*, MemSpace>("contact_dq", n);
   }
-  find_pairs(x, ConstDofView());
+  // The graph's pairs: those within (1 + margin) dhat, a superset of the
+  // pairs within dhat (energy, gradient and Hessian skip pairs at d >= dhat).
+  find_pairs(x, ConstDofView(), dhat_ * (1.0 + graph_margin_));
   // Signature of the couplings: each pair with its particle's stencil base
   // node (the stencil's other nodes follow from it while the MPM cells are
   // unchanged; when they change, the MPM term's version forces a rebuild).
@@ -98,13 +100,13 @@ void BarrierTerm<dim>::begin_step(const ParticleStencils<dim>& ps, ConstDofView 
 }
 
 template <int dim>
-void BarrierTerm<dim>::find_pairs(ConstDofView x, ConstDofView p) const {
+void BarrierTerm<dim>::find_pairs(ConstDofView x, ConstDofView p, double pad) const {
   ScopeTimer timer(timings_.broad_phase_s);
   const bool moving = p.extent(0) > 0;
   interpolate_particles(ps_, x, xq_);
   if (moving) interpolate_particles(ps_, p, dq_);
   point_boxes<dim>(xq_, moving ? ConstDofView(dq_) : ConstDofView(), 0.0, particle_boxes_);
-  simplex_boxes<dim, dim>(prims_.nodes, x, p, dhat_, prim_boxes_);
+  simplex_boxes<dim, dim>(prims_.nodes, x, p, pad < 0 ? dhat_ : pad, prim_boxes_);
   hash_.build(prim_boxes_);
   if (prims_.size() == 0 || ps_.size() == 0) {
     n_pairs_ = 0;

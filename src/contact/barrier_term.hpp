@@ -37,6 +37,8 @@ class BarrierTerm : public EnergyTerm<dim> {
   bool update(ConstDofView x) const override;
   void prepare_direction(ConstDofView x, ConstDofView p) const override;
   void set_projection(bool project) { project_ = project; }  // false: exact Hessian (tests)
+  // begin_step's graph pairs: within (1 + margin) dhat of x^n (default 0).
+  void set_graph_margin(double margin) { graph_margin_ = margin; }
 
   // Pairs (particle, primitive) near x with d < dhat: their distance and the
   // normal force magnitude lambda = -omega c b'(d) (N in 3D, N/m in 2D).
@@ -64,13 +66,15 @@ class BarrierTerm : public EnergyTerm<dim> {
   LO candidate_pairs() const { return n_pairs_; }
 
  private:
-  void find_pairs(ConstDofView x, ConstDofView p) const;  // p empty: static
+  // Pairs whose boxes (primitives padded by pad, default dhat) overlap; p empty: static.
+  void find_pairs(ConstDofView x, ConstDofView p, double pad = -1.0) const;
   template <class Body>
   void for_each_pair(ConstDofView x, const Body& body) const;
 
   BoundaryPrimitives<dim> prims_;
   double dhat_, kappa_;
   bool project_ = true;
+  double graph_margin_ = 0.0;
   ParticleStencils<dim> ps_;
   mutable SpatialHash<dim> hash_;
   mutable Boxes<dim> prim_boxes_, particle_boxes_;

@@ -13,6 +13,7 @@ namespace bfemp {
 template <int dim>
 Contact<dim>::Contact(const FemMesh<dim>& mesh, ContactParams params) : mesh_(mesh), params_(std::move(params)) {
   barrier_ = std::make_unique<BarrierTerm<dim>>(boundary_primitives(mesh), params_.dhat, params_.kappa);
+  barrier_->set_graph_margin(params_.graph_margin);
   bool any_mu = false;
   for (double m : params_.mu) any_mu = any_mu || m > 0;
   if (any_mu)

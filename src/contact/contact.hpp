@@ -18,6 +18,10 @@ struct ContactParams {
   double dhat = 1e-3;    // m, contact activation distance
   double kappa = 1e5;    // Pa, barrier stiffness
   double eps_v = 1e-3;   // m/s, static-friction velocity bound
+  // The step's matrix graph holds the pairs within (1 + graph_margin) dhat at
+  // x^n, so pairs the Newton iterates bring within dhat are mostly in it
+  // already (no rebuild, no new symbolic analysis inside the step).
+  double graph_margin = 3.0;
   int friction_max_iterations = 20;  // outer friction loop cap per step
   std::vector<double> mu;  // [mpm body * n_fem + fem body]; empty: frictionless
   int force_body = -1;     // FEM body whose contact force is reported (-1: all)

@@ -86,6 +86,7 @@ ContactParams contact_from(const ParameterList& p) {
   cp.dhat = c.get<double>("dhat");
   cp.kappa = c.get<double>("kappa");
   cp.eps_v = c.get<double>("eps_v");
+  cp.graph_margin = c.get<double>("graph margin");
   cp.friction_max_iterations = c.get<int>("friction iterations");
   const std::size_t nm = mpm.numParams(), nf = fem.numParams();
   cp.fem_fem = c.get<bool>("FEM-FEM");

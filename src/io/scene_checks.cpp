@@ -105,6 +105,8 @@ void check_contact(const ParameterList& raw) {
   const auto& c = raw.sublist("Contact");
   for (const char* k : {"dhat", "kappa", "eps_v"}) positive(c, "Contact/", k, "a positive value");
   if (!(c.get<double>("friction") >= 0)) bad("Contact/friction", num(c.get<double>("friction")), "mu >= 0");
+  if (!(c.get<double>("graph margin") >= 0))
+    bad("Contact/graph margin", num(c.get<double>("graph margin")), "a margin >= 0 (in multiples of dhat)");
   at_least(c, "Contact/", "friction iterations", 1);
   const std::string fb = c.get<std::string>("force body");
   if (!fb.empty() && !raw.sublist("FEM Bodies").isSublist(fb))

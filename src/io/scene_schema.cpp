@@ -218,6 +218,10 @@ Teuchos::RCP<const ParameterList> scene_schema() {
   contact.set("dhat", 1e-3, "contact activation distance (m), > 0");
   contact.set("kappa", 1e5, "barrier stiffness (Pa), > 0");
   contact.set("eps_v", 1e-3, "static-friction velocity bound (m/s), > 0");
+  contact.set("graph margin", 3.0,
+              "the matrix graph of a step holds the pairs within (1 + margin) dhat at its start, so that pairs the "
+              "Newton iterates bring within dhat need no graph rebuild; >= 0 (a speed knob: results change only "
+              "at round-off)");
   contact.set("friction", 0.0, "Coulomb coefficient mu of every MPM/FEM body pair, >= 0");
   contact.sublist("Friction Pairs", false,
                   "per-pair mu overriding 'friction': keys '<MPM body> : <FEM body>', or '<FEM body> : <FEM body>' "
