@@ -266,6 +266,7 @@ NewtonStats NewtonSolver<dim>::minimize(const IncrementalPotential& ip, View1 x)
     if (it == 0) r0_norm = r_norm;
     const double forcing = r0_norm > 0 ? r_norm / r0_norm : 0.0;
     LinearSolveStats ls;
+    bool fallback = false;
     try {
       ls = m.solver.solve(*m.b, *m.p, forcing > 0 ? forcing : 1e-300);
     } catch (const NotPositiveDefinite&) {
@@ -274,6 +275,7 @@ NewtonStats NewtonSolver<dim>::minimize(const IncrementalPotential& ip, View1 x)
       st.solve_s += timer.seconds();
       ++st.projection_fallbacks;
       ++st.numeric_factorizations;  // the one that failed
+      fallback = true;
       project = true;
       timer.reset();
       m.assemble(ip, x, project);
@@ -399,8 +401,9 @@ NewtonStats NewtonSolver<dim>::minimize(const IncrementalPotential& ip, View1 x)
     st.line_search_s += timer.seconds();
     st.min_step = std::min(st.min_step, alpha);
     if (m.params.log_iterations && m.comm->getRank() == 0)
-      std::fprintf(stderr, "  newton %3d  |p|/dt %.3e m/s  step %.3e  (bound %.3e)  |rhs| %.3e  %s Hessian\n", it + 1,
-                   p_inf / ip.dt, alpha, 0.9 * a_max, r_norm, project ? "projected" : "exact");
+      std::fprintf(stderr, "  newton %3d  |p|/dt %.3e m/s  step %.3e  (bound %.3e)  |rhs| %.3e  %s Hessian  linear %d it%s%s\n",
+                   it + 1, p_inf / ip.dt, alpha, 0.9 * a_max, r_norm, project ? "projected" : "exact", ls.iterations,
+                   ls.factorised ? " (factorised)" : "", fallback ? " after a non-positive pivot" : "");
     st.iterations = it + 1;
     if (on_iterate) on_iterate(x);
     if (converged) return st;
