@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstring>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "solver/solver_error.hpp"
@@ -31,7 +32,9 @@ std::string status_name(int s) {
 
 struct CholmodDirect::Impl {
   cholmod_common c{};
-  cholmod_factor* L = nullptr;
+  cholmod_factor* L = nullptr;      // the factor solves use (after the analysis: symbolic)
+  cholmod_factor* spare = nullptr;  // same analysis; a factorisation while L is valid goes here,
+                                    // so a failed one (not positive definite) leaves L usable
   cholmod_dense* X = nullptr;  // solution workspace, reused
   cholmod_dense* Y = nullptr;
   cholmod_dense* E = nullptr;
@@ -50,6 +53,7 @@ struct CholmodDirect::Impl {
   }
   ~Impl() {
     if (L) cholmod_l_free_factor(&L, &c);
+    if (spare) cholmod_l_free_factor(&spare, &c);
     if (X) cholmod_l_free_dense(&X, &c);
     if (Y) cholmod_l_free_dense(&Y, &c);
     if (E) cholmod_l_free_dense(&E, &c);
@@ -87,6 +91,7 @@ void CholmodDirect::set_matrix(const Teuchos::RCP<const Matrix>& A) {
   m.i.resize(lcl.graph.entries.extent(0));
   for (std::size_t k = 0; k < m.i.size(); ++k) m.i[k] = lcl.graph.entries(k);
   if (m.L) cholmod_l_free_factor(&m.L, &m.c);
+  if (m.spare) cholmod_l_free_factor(&m.spare, &m.c);
   m.analysed = false;
   m.factor_ok = false;
   if (m.reuse.max_iterations > 0 && m.cg_x.extent(0) != n) {
@@ -213,14 +218,24 @@ CholmodDirect::Result CholmodDirect::solve(const Vector& b, Vector& x) {
     m.analysed = true;
     analysed_now = true;
   }
-  m.factor_ok = false;
   res.analysed = analysed_now;
   res.factorised = true;
-  if (!cholmod_l_factorize(&S, m.L, &m.c) || m.c.status != CHOLMOD_OK) {
+  // With reuse, keep the valid factor until the new one succeeds: after a
+  // non-positive pivot (exact Hessian) the projected matrix's solve can then
+  // still run CG on it. The spare is a copy made once per graph.
+  const bool keep = m.factor_ok && m.reuse.max_iterations > 0;
+  if (keep && !m.spare) {
+    m.spare = cholmod_l_copy_factor(m.L, &m.c);
+    if (!m.spare) throw SolverError("Cholmod factor copy failed: " + status_name(m.c.status));
+  }
+  cholmod_factor* target = keep ? m.spare : m.L;
+  if (!keep) m.factor_ok = false;
+  if (!cholmod_l_factorize(&S, target, &m.c) || m.c.status != CHOLMOD_OK) {
     if (m.c.status == CHOLMOD_NOT_POSDEF)
       throw NotPositiveDefinite("Cholmod factorisation failed: " + status_name(m.c.status));
     throw SolverError("Cholmod factorisation failed: " + status_name(m.c.status));
   }
+  if (keep) std::swap(m.L, m.spare);
   m.factor_ok = true;
   auto bv = b.getLocalViewDevice(Tpetra::Access::ReadOnly);
   cholmod_dense B{};
