@@ -149,6 +149,7 @@ void accumulate(RunSummary& s, const StepReport& r) {
   s.contact_ccd_s += r.contact_ccd_s;
   s.symbolic_factorizations += r.newton.symbolic_factorizations;
   s.numeric_factorizations += r.newton.numeric_factorizations;
+  s.projected_retries += r.newton.projected_retries;
   s.exact_hessian_iterations += r.newton.exact_hessian_iterations;
   s.projection_fallbacks += r.newton.projection_fallbacks;
 }
@@ -344,6 +345,9 @@ RunSummary run_scene(const Scene& scene, const std::string& dir, const Teuchos::
   if (s.exact_hessian_iterations + s.projection_fallbacks > 0)
     log << "  exact Hessian       " << s.exact_hessian_iterations << " of " << s.newton_iterations
         << " iterations (" << s.projection_fallbacks << " not positive definite: projected)\n";
+  if (s.projected_retries > 0)
+    log << "  steps redone        " << s.projected_retries
+        << " (Newton failed with the exact Hessian; the projected one converged)\n";
   log
       << "  line-search time    " << s.line_search_s << " s\n";
   if (s.contact)

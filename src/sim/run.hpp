@@ -25,6 +25,7 @@ struct RunSummary {
   int frames = 0;
   int checkpoints = 0;
   long graph_builds = 0, symbolic_factorizations = 0, numeric_factorizations = 0;
+  long projected_retries = 0;  // steps redone with the projected Hessian
   long exact_hessian_iterations = 0, projection_fallbacks = 0;  // Newton/hessian: exact-if-definite
   std::vector<std::pair<std::string, double>> term_assembly_s;  // per energy term
 };

@@ -17,14 +17,15 @@ using View1 = Kokkos::View<double*, MemSpace>;
 // shrinks, so steps do not reallocate.
 template <int dim>
 struct Simulation<dim>::System {
-  View1 x, v, v_old, a, x_hat, target, mass, work, x_ref, weight;
+  View1 x, v, v_old, a, x_hat, target, mass, work, x_ref, weight, x_start;
   Kokkos::View<int*, MemSpace> prescribed;
   std::size_t n = 0;
   void resize(std::size_t nd) {
     n = nd;
     if (x.extent(0) >= nd) return;
     const std::size_t cap = nd + nd / 4;
-    for (View1* w : {&x, &v, &v_old, &a, &x_hat, &target, &mass, &work, &x_ref, &weight}) *w = View1(w->label(), cap);
+    for (View1* w : {&x, &v, &v_old, &a, &x_hat, &target, &mass, &work, &x_ref, &weight, &x_start})
+      *w = View1(w->label(), cap);
     prescribed = Kokkos::View<int*, MemSpace>("sys_prescribed", cap);
   }
   template <class V>
@@ -320,7 +321,7 @@ StepReport Simulation<dim>::step() {
   }
   NewtonStats ns;
   int friction_iters = 0;
-  try {
+  auto minimize_step = [&]() {
     if (contact_ && contact_->has_friction()) {
       // dt v^{n+1} = s (x - x_ref) for the integrator's velocity update.
       const double gm = ti.gamma, s = gm * dt * dt / h;
@@ -333,6 +334,36 @@ StepReport Simulation<dim>::step() {
     } else {
       ns = distributed_ ? minimize_distributed(ip, x, System::head(S.work, nd)) : newton_->minimize(ip, x);
       friction_iters = 1;
+    }
+  };
+  // Newton on the exact Hessian can stall where it is nearly singular (A6:
+  // a period-5 cycle through one direction, each visit accepted with a step
+  // of 4e-3). A step that fails so is redone from its start with the
+  // projected Hessian, which converges there.
+  const bool can_retry = newton_->hessian_mode() == HessianMode::ExactIfDefinite &&
+                         newton_->linear_solver().kind() == LinearSolverKind::Cholmod && !distributed_;
+  auto x_start = System::head(S.x_start, nd);
+  if (can_retry) Kokkos::deep_copy(x_start, x);
+  try {
+    try {
+      minimize_step();
+    } catch (const SolverError& e) {
+      if (!can_retry) throw;
+      Kokkos::deep_copy(x, x_start);
+      newton_->new_time_step();
+      newton_->set_hessian_mode(HessianMode::Projected);
+      try {
+        minimize_step();
+      } catch (const SolverError& e2) {
+        newton_->set_hessian_mode(HessianMode::ExactIfDefinite);
+        throw SolverError(std::string(e.what()) + "; redone with the projected Hessian: " + e2.what());
+      }
+      newton_->set_hessian_mode(HessianMode::ExactIfDefinite);
+      ns.projected_retries = 1;
+      if (comm_->getRank() == 0)
+        std::cerr << "warning: step " << step_ + 1 << " (t = " << t1 << " s): " << e.what()
+                  << " with the exact Hessian; redone with the projected Hessian (" << ns.iterations
+                  << " iterations)\n";
     }
   } catch (const SolverError& e) {
     std::ostringstream msg;

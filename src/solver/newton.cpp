@@ -150,6 +150,16 @@ const DofSpace<dim>& NewtonSolver<dim>::dof_space() const {
 }
 
 template <int dim>
+HessianMode NewtonSolver<dim>::hessian_mode() const {
+  return impl_->params.hessian;
+}
+
+template <int dim>
+void NewtonSolver<dim>::set_hessian_mode(HessianMode mode) {
+  impl_->params.hessian = mode;
+}
+
+template <int dim>
 void NewtonSolver<dim>::new_time_step() {
   impl_->solver.forget_factor();
 }

@@ -49,6 +49,7 @@ struct NewtonStats {
   int graph_builds = 0;            // graph rebuilds inside the solve (contact pairs outside the graph)
   int symbolic_factorizations = 0; // direct solvers: symbolic phases run
   int numeric_factorizations = 0;  // direct solvers: numeric factorisations run (failed ones too)
+  int projected_retries = 0;       // the step failed with the exact Hessian and was redone projected
   int exact_hessian_iterations = 0; // iterations solved with the exact Hessian
   int projection_fallbacks = 0;     // exact Hessian not positive definite: projected instead
 };
@@ -94,6 +95,8 @@ class NewtonSolver {
   // reuses a factor only within one step, so a restarted run takes the same
   // path as the run it continues).
   void new_time_step();
+  HessianMode hessian_mode() const;
+  void set_hessian_mode(HessianMode mode);
 
   // Minimises E from the initial guess in `x` (overwritten with the result).
   // Throws SolverError when the linear solve fails, the line search stalls or
