@@ -347,18 +347,23 @@ StepReport Simulation<dim>::step() {
   try {
     try {
       minimize_step();
-    } catch (const SolverError& e) {
+    } catch (const NewtonStalled& e) {  // not a failed check ('Contact/check iterates') or a linear-solver error
       if (!can_retry) throw;
       Kokkos::deep_copy(x, x_start);
       newton_->new_time_step();
-      newton_->set_hessian_mode(HessianMode::Projected);
-      try {
-        minimize_step();
-      } catch (const SolverError& e2) {
-        newton_->set_hessian_mode(HessianMode::ExactIfDefinite);
-        throw SolverError(std::string(e.what()) + "; redone with the projected Hessian: " + e2.what());
+      struct ProjectedForThisStep {  // the mode comes back whatever the redo throws
+        NewtonSolver<dim>& n;
+        explicit ProjectedForThisStep(NewtonSolver<dim>& s) : n(s) { n.set_hessian_mode(HessianMode::Projected); }
+        ~ProjectedForThisStep() { n.set_hessian_mode(HessianMode::ExactIfDefinite); }
+      };
+      {
+        ProjectedForThisStep projected(*newton_);
+        try {
+          minimize_step();
+        } catch (const SolverError& e2) {
+          throw SolverError(std::string(e.what()) + "; redone with the projected Hessian: " + e2.what());
+        }
       }
-      newton_->set_hessian_mode(HessianMode::ExactIfDefinite);
       ns.projected_retries = 1;
       if (comm_->getRank() == 0)
         std::cerr << "warning: step " << step_ + 1 << " (t = " << t1 << " s): " << e.what()

@@ -22,8 +22,10 @@ int blas_threads() {
 std::string configure_blas_threads() {
   const SetThreads set = set_fn();
   if (!set || !get_fn()) return "BLAS: not OpenBLAS (its threads left as they are)";
-  const char* user = std::getenv("OPENBLAS_NUM_THREADS");
-  if (user && *user) return "BLAS: OpenBLAS, " + std::to_string(blas_threads()) + " thread(s) (OPENBLAS_NUM_THREADS)";
+  for (const char* var : {"OPENBLAS_NUM_THREADS", "GOTO_NUM_THREADS"}) {
+    const char* user = std::getenv(var);
+    if (user && *user) return "BLAS: OpenBLAS, " + std::to_string(blas_threads()) + " thread(s) (" + var + ")";
+  }
   set(1);
   return "BLAS: OpenBLAS, " + std::to_string(blas_threads()) + " thread(s)";
 }

@@ -2,11 +2,14 @@
 // Threads of the BLAS under CHOLMOD's supernodal factorisation.
 //
 // Debian links SuiteSparse against the system BLAS (an alternative: OpenBLAS,
-// pthreads build, on the reference machines). OpenBLAS starts one thread per
-// core whatever OMP_NUM_THREADS says, and its workers are created by the main
-// thread, so with OMP_PROC_BIND they inherit its one-core mask and all share
-// core 0 with Kokkos' thread 0. bfemp therefore runs the BLAS on one thread,
-// unless OPENBLAS_NUM_THREADS says otherwise.
+// pthreads build, on the reference machines). OpenBLAS starts as many threads
+// as OPENBLAS_NUM_THREADS, GOTO_NUM_THREADS or OMP_NUM_THREADS say (else one
+// per core), and its workers are created by the main thread, so with
+// OMP_PROC_BIND they inherit its one-core mask and all share core 0 with
+// Kokkos' thread 0. bfemp therefore runs the BLAS on one thread, unless
+// OPENBLAS_NUM_THREADS or GOTO_NUM_THREADS says otherwise. (On an OpenMP
+// build of OpenBLAS, openblas_set_num_threads sets OpenMP's thread count
+// too; Debian's default is the pthreads build.)
 //
 // Measured on the rings at the paper's size (9408 DOFs, 6.4e7 flops per
 // numeric factorisation), Kokkos at 2 threads on this 2-core VM:
@@ -25,7 +28,7 @@
 
 namespace bfemp {
 
-// One OpenBLAS thread unless OPENBLAS_NUM_THREADS is set; returns a line for
+// One OpenBLAS thread unless OPENBLAS_NUM_THREADS or GOTO_NUM_THREADS is set; returns a line for
 // the start banner, e.g. "BLAS: OpenBLAS, 1 thread(s)" or
 // "BLAS: OpenBLAS, 2 thread(s) (OPENBLAS_NUM_THREADS)".
 std::string configure_blas_threads();

@@ -42,6 +42,7 @@ struct CholmodDirect::Impl {
   std::vector<SuiteSparse_long> p, i;  // CHOLMOD's index type; built once per graph
   bool analysed = false;
   bool factor_ok = false;  // L holds a complete numeric factor of this graph
+  bool spare_wanted = false;  // a non-positive pivot was met in this step: keep L while refactorising
   Reuse reuse;
   using V = Kokkos::View<double*, MemSpace>;
   V cg_x, cg_r, cg_z, cg_p, cg_q;  // CG work, sized once per graph
@@ -50,6 +51,10 @@ struct CholmodDirect::Impl {
     cholmod_l_start(&c);
     c.print = 0;
     c.error_handler = nullptr;  // errors come back as c.status
+    // Simplicial factors (small or very sparse matrices) as LL', not LDL':
+    // LDL' reports only an exactly zero pivot, so an indefinite exact Hessian
+    // would pass as definite. (Supernodal factors are always LL'.)
+    c.final_ll = 1;
   }
   ~Impl() {
     if (L) cholmod_l_free_factor(&L, &c);
@@ -103,7 +108,10 @@ void CholmodDirect::set_matrix(const Teuchos::RCP<const Matrix>& A) {
   }
 }
 
-void CholmodDirect::forget_factor() { impl_->factor_ok = false; }
+void CholmodDirect::forget_factor() {  // a new step starts as a restart would
+  impl_->factor_ok = false;
+  impl_->spare_wanted = false;
+}
 
 namespace {
 using Range = Kokkos::RangePolicy<ExecSpace>;
@@ -163,7 +171,16 @@ static bool cg_on_old_factor(CholmodDirect::Reuse reuse, cholmod_common& c, chol
           q(i) = acc;
         });
     const double pq = dot(p, q);
-    if (!(pq > 0.0) || !(rz > 0.0)) return false;  // non-positive curvature: let the factorisation decide
+    if (!(pq > 0.0) || !(rz > 0.0)) {
+      // p^T A p < 0 for some p proves A indefinite, whatever the
+      // preconditioner: say so without a factorisation bound to fail. A
+      // round-off zero (a positive semi-definite A) goes to the factorisation.
+      const double pn = std::sqrt(dot(p, p)), qn = std::sqrt(dot(q, q));
+      if (pq < -1e-8 * pn * qn)
+        throw NotPositiveDefinite("CG on the previous Cholmod factor met negative curvature (p^T A p = " +
+                                  std::to_string(pq) + "): the matrix is not positive definite");
+      return false;
+    }
     const double alpha = rz / pq;
     double rr = 0;
     Kokkos::parallel_reduce(
@@ -220,10 +237,12 @@ CholmodDirect::Result CholmodDirect::solve(const Vector& b, Vector& x) {
   }
   res.analysed = analysed_now;
   res.factorised = true;
-  // With reuse, keep the valid factor until the new one succeeds: after a
-  // non-positive pivot (exact Hessian) the projected matrix's solve can then
-  // still run CG on it. The spare is a copy made once per graph.
-  const bool keep = m.factor_ok && m.reuse.max_iterations > 0;
+  // With reuse, once a non-positive pivot has been met (exact Hessian), keep
+  // the valid factor until the new one succeeds, so that the projected
+  // matrix's solve can still run CG on it. The spare is a copy made once per
+  // graph, and only in runs that meet such pivots (it doubles the factor's
+  // memory).
+  const bool keep = m.factor_ok && m.reuse.max_iterations > 0 && m.spare_wanted;
   if (keep && !m.spare) {
     m.spare = cholmod_l_copy_factor(m.L, &m.c);
     if (!m.spare) throw SolverError("Cholmod factor copy failed: " + status_name(m.c.status));
@@ -231,8 +250,10 @@ CholmodDirect::Result CholmodDirect::solve(const Vector& b, Vector& x) {
   cholmod_factor* target = keep ? m.spare : m.L;
   if (!keep) m.factor_ok = false;
   if (!cholmod_l_factorize(&S, target, &m.c) || m.c.status != CHOLMOD_OK) {
-    if (m.c.status == CHOLMOD_NOT_POSDEF)
+    if (m.c.status == CHOLMOD_NOT_POSDEF) {
+      m.spare_wanted = true;
       throw NotPositiveDefinite("Cholmod factorisation failed: " + status_name(m.c.status));
+    }
     throw SolverError("Cholmod factorisation failed: " + status_name(m.c.status));
   }
   if (keep) std::swap(m.L, m.spare);

@@ -16,8 +16,16 @@
 // first). CG stops and the matrix is factorised instead when it has not
 // reached tol after `max_iterations`, when its residual falls too slowly to
 // reach tol within them (rate test after 4 iterations), or on a direction of
-// non-positive curvature (p^T A p <= 0: the exact Hessian may be indefinite,
-// and the factorisation then says so as CHOLMOD_NOT_POSDEF).
+// zero curvature (round-off, a semi-definite A). Negative curvature,
+// p^T A p < -1e-8 |p| |A p|, proves A indefinite: the solve throws
+// NotPositiveDefinite as a failed factorisation would. CG may also converge
+// on an indefinite A without meeting negative curvature; its x then solves
+// A x = b like the factorisation's would, but an exact-Hessian Newton
+// iteration is not told that A is indefinite (the line search still demands
+// descent). Once a factorisation has failed on a non-positive pivot, later
+// factorisations of that time step go into a spare factor, so the last good one survives the
+// next failure (memory: twice the factor). CG's result counts as exact (the
+// solve reports tolerance 0), at the reuse tolerance.
 //
 // The matrix is symmetric (the DOF space eliminates constraints
 // symmetrically), so its CRS arrays read as compressed columns are A itself;

@@ -399,7 +399,7 @@ NewtonStats NewtonSolver<dim>::minimize(const IncrementalPotential& ip, View1 x)
           std::ostringstream msg;
           msg << "line search stalled at Newton iteration " << it + 1 << " (step " << alpha
               << ", |p|_inf/dt = " << p_inf / ip.dt << " m/s, eps_d = " << m.params.eps_d << ")";
-          throw SolverError(msg.str());
+          throw NewtonStalled(msg.str());
         }
       }
     }
@@ -421,7 +421,7 @@ NewtonStats NewtonSolver<dim>::minimize(const IncrementalPotential& ip, View1 x)
   std::ostringstream msg;
   msg << "Newton did not converge in " << m.params.max_iterations
       << " iterations (raise 'Newton/max iterations' or reduce dt)";
-  throw SolverError(msg.str());
+  throw NewtonStalled(msg.str());
 }
 
 template class NewtonSolver<2>;

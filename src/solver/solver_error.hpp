@@ -16,4 +16,11 @@ class NotPositiveDefinite : public SolverError {
  public:
   using SolverError::SolverError;
 };
+// Newton stopped without converging: the iteration cap or a stalled line
+// search (not a failed check or a linear-solver error). A step that fails so
+// with the exact Hessian is redone with the projected one.
+class NewtonStalled : public SolverError {
+ public:
+  using SolverError::SolverError;
+};
 }  // namespace bfemp

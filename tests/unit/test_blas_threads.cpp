@@ -33,6 +33,12 @@ TEST(BlasThreads, OneUnlessTheUserSetOpenblasNumThreads) {
   EXPECT_EQ(bfemp::configure_blas_threads(), "BLAS: OpenBLAS, 1 thread(s)");
   EXPECT_EQ(bfemp::blas_threads(), 1);
 
+  // GOTO_NUM_THREADS, which OpenBLAS also reads, is kept too.
+  set(2);
+  setenv("GOTO_NUM_THREADS", "2", 1);
+  EXPECT_EQ(bfemp::configure_blas_threads(), "BLAS: OpenBLAS, 2 thread(s) (GOTO_NUM_THREADS)");
+  unsetenv("GOTO_NUM_THREADS");
+
   // The user's OPENBLAS_NUM_THREADS wins: the count is left as it is.
   set(2);
   setenv("OPENBLAS_NUM_THREADS", "2", 1);

@@ -122,29 +122,75 @@ TEST(CholmodReuse, FarValuesAreFactorisedAnew) {
 }
 
 TEST(CholmodReuse, AnIndefiniteMatrixIsReportedNotSolvedByCg) {
+  // Diagonal 4 + shift, off-diagonals -1: eigenvalues in (shift + 0.044,
+  // shift + 7.96). A shift of -0.1 leaves one negative eigenvalue.
   Fixture f;
   CholmodDirect solver(CholmodReuse{20, 1e-10});
   solver.set_matrix(f.A);
   solver.solve(f.b, f.x);
-  // Laplacian eigenvalues lie in (0, 8): a shift of -6 makes it indefinite.
-  copy_values(*laplacian(std::vector<double>(kN, -6.0)), *f.A);
+  copy_values(*laplacian(std::vector<double>(kN, -0.1)), *f.A);
   EXPECT_THROW(solver.solve(f.b, f.x), NotPositiveDefinite);
-  // The failed factorisation went into the spare: the last good factor is
-  // kept, so the next solve (the projected Hessian, here the first matrix
-  // again) is CG on it, one iteration.
+  // Definite again (the projected Hessian, here the first matrix): solved,
+  // by CG on the factor that survived or by a new factorisation.
   copy_values(*laplacian(f.shift), *f.A);
+  solver.solve(f.b, f.x);
+  EXPECT_LT(relative_residual(*f.A, f.x, f.b), 1e-10);
+}
+
+// Without reuse too: a mildly indefinite matrix is refused. CHOLMOD factorises
+// this small, sparse matrix simplicially; as LDL' that reported only an exact
+// zero pivot and passed every shift but -6.
+TEST(CholmodReuse, MildlyIndefiniteMatricesFailTheFactorisation) {
+  for (double shift : {-0.1, -1.0, -5.9, -6.5}) {
+    Fixture f;
+    copy_values(*laplacian(std::vector<double>(kN, shift)), *f.A);
+    CholmodDirect solver(CholmodReuse{0, 1e-10});
+    solver.set_matrix(f.A);
+    EXPECT_THROW(solver.solve(f.b, f.x), NotPositiveDefinite) << "shift " << shift;
+  }
+}
+
+// After one non-positive pivot, later factorisations go into a spare: the
+// next failure leaves the last good factor, and the definite solve after it
+// runs CG on that factor.
+TEST(CholmodReuse, AfterAFailedFactorisationTheGoodFactorSurvivesTheNext) {
+  Fixture f;
+  CholmodDirect solver(CholmodReuse{20, 1e-10});
+  solver.set_matrix(f.A);
+  // First failure: no factor yet (the first solve of the graph factorises).
+  copy_values(*laplacian(std::vector<double>(kN, -6.5)), *f.A);
+  EXPECT_THROW(solver.solve(f.b, f.x), NotPositiveDefinite);
+  copy_values(*laplacian(f.shift), *f.A);
+  EXPECT_TRUE(solver.solve(f.b, f.x).factorised);
+  // Far, definite values: CG gives up, the factorisation goes to the spare.
+  std::vector<double> far(kN);
+  for (int i = 0; i < kN; ++i) far[i] = std::pow(10.0, (i % 7) - 3.0);
+  copy_values(*laplacian(far), *f.A);
+  EXPECT_TRUE(solver.solve(f.b, f.x).factorised);
+  // Strongly indefinite, far from the factor: whichever way it is found, L survives.
+  copy_values(*laplacian(std::vector<double>(kN, -6.5)), *f.A);
+  EXPECT_THROW(solver.solve(f.b, f.x), NotPositiveDefinite);
+  copy_values(*laplacian(far), *f.A);
   const auto r = solver.solve(f.b, f.x);
   EXPECT_FALSE(r.factorised);
   EXPECT_LE(r.cg_iterations, 2);
   EXPECT_LT(relative_residual(*f.A, f.x, f.b), 1e-10);
-  // Without reuse a failed factorisation leaves nothing: the next solve factorises.
-  CholmodDirect plain(CholmodReuse{0, 1e-10});
-  copy_values(*laplacian(std::vector<double>(kN, -6.0)), *f.A);
-  plain.set_matrix(f.A);
-  EXPECT_THROW(plain.solve(f.b, f.x), NotPositiveDefinite);
-  copy_values(*laplacian(f.shift), *f.A);
-  EXPECT_TRUE(plain.solve(f.b, f.x).factorised);
-  EXPECT_LT(relative_residual(*f.A, f.x, f.b), 1e-13);
+}
+
+// A new graph (set_matrix) drops the factor: the next solve analyses and factorises.
+TEST(CholmodReuse, ANewGraphIsAnalysedAndFactorised) {
+  Fixture f;
+  CholmodDirect solver(CholmodReuse{20, 1e-10});
+  solver.set_matrix(f.A);
+  solver.solve(f.b, f.x);
+  EXPECT_FALSE(solver.solve(f.b, f.x).factorised);  // same values: CG, one iteration
+  auto B = laplacian(f.shift);
+  solver.set_matrix(B);
+  const auto r = solver.solve(f.b, f.x);
+  EXPECT_TRUE(r.analysed);
+  EXPECT_TRUE(r.factorised);
+  EXPECT_EQ(r.cg_iterations, 0);
+  EXPECT_LT(relative_residual(*B, f.x, f.b), 1e-13);
 }
 
 TEST(CholmodReuse, ZeroIterationsFactorisesEverySolve) {
