@@ -81,7 +81,7 @@ RunOutput<dim>::RunOutput(const std::string& dir, const Scene& scene, const Simu
   // Explicit polyvertex connectivity 0 .. np-1: without it ParaView's Xdmf3
   // readers give the particle grid points but no cells (nothing is drawn).
   if (const auto* mpm = sim.mpm(); mpm && !resume) {
-    std::vector<long long> ids(mpm->particles().size());
+    std::vector<long long> ids(static_cast<std::size_t>(mpm->total_particles()));
     for (std::size_t q = 0; q < ids.size(); ++q) ids[q] = static_cast<long long>(q);
     h5_->write_static("particle_vertices", ids.data(), ids.size(), 1);
   }
@@ -104,7 +104,7 @@ XdmfFrame RunOutput<dim>::xdmf_frame(const Simulation<dim>& sim, int index, doub
     frame.grids.push_back(g);
   }
   if (const auto* mpm = sim.mpm()) {
-    XdmfGrid g = xdmf_particle_grid(index, mpm->particles().size(), dim);
+    XdmfGrid g = xdmf_particle_grid(index, static_cast<std::size_t>(mpm->total_particles()), dim);
     g.node_attributes = {{"velocity", "particle_velocities", dim},
                          {"von_mises", "particle_von_mises", 1},
                          {"J", "particle_J", 1},
@@ -116,7 +116,7 @@ XdmfFrame RunOutput<dim>::xdmf_frame(const Simulation<dim>& sim, int index, doub
 }
 
 template <int dim>
-void RunOutput<dim>::write_frame(const Simulation<dim>& sim) {
+void RunOutput<dim>::write_frame(const Simulation<dim>& sim, const Particles<dim>* gathered) {
   const auto& mesh = sim.mesh();
   const std::size_t nn = mesh.num_nodes(), ne = mesh.num_cells();
   auto x = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), sim.positions());
@@ -134,7 +134,7 @@ void RunOutput<dim>::write_frame(const Simulation<dim>& sim) {
     h5_->write_array("J", Jh.data(), ne, 1);
   }
   if (const auto* mpm = sim.mpm()) {
-    const auto& p = mpm->particles();
+    const auto& p = gathered ? *gathered : mpm->particles();
     const std::size_t np = p.size();
     Kokkos::View<double*, MemSpace> pJ("frame_particle_J", np), pvm("frame_particle_vm", np);
     mpm_particle_J_von_mises<dim>(p, sim.mesh().elements.materials, pJ, pvm);

@@ -38,7 +38,9 @@ class RunOutput {
   // continuation of the directory's existing files.
   RunOutput(const std::string& dir, const Scene& scene, const Simulation<dim>& sim,
             const OutputResume* resume = nullptr);
-  void write_frame(const Simulation<dim>& sim);
+  // MPI runs of MPM bodies pass every rank's particles gathered in id order
+  // (MpmBodies::gathered_particles); otherwise the simulation's are written.
+  void write_frame(const Simulation<dim>& sim, const Particles<dim>* gathered = nullptr);
   void write_diagnostics(const StepReport& r) { csv_->write_row(diagnostics_row(r)); }
   void close() { h5_->close(); }
   int frames_written() const { return frame_; }

@@ -1,7 +1,15 @@
 #include "mpm/mpm_bodies.hpp"
 
+#include "solver/tpetra_types.hpp"
+
+#include <Teuchos_CommHelpers.hpp>
+#include <Tpetra_Export.hpp>
+#include <Tpetra_Import.hpp>
+#include <Tpetra_Map.hpp>
+#include <Tpetra_MultiVector.hpp>
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 #include <unordered_set>
 
@@ -53,60 +61,223 @@ void MpmElasticityTerm<dim>::assemble(ConstDofView x, const Sink<dim>& sink) con
 }
 
 template <int dim>
+struct MpmBodies<dim>::Halo {
+  Teuchos::RCP<const Map> overlap, owned;
+  Teuchos::RCP<const Tpetra::Export<LO, GO, Node>> exporter;
+  Teuchos::RCP<const Tpetra::Import<LO, GO, Node>> importer;
+};
+
+template <int dim>
 MpmBodies<dim>::MpmBodies(MpmSetup<dim> setup, Kokkos::View<MaterialParams*, MemSpace> materials)
     : setup_(std::move(setup)), materials_(materials) {
   const std::size_t np = setup_.particles.size();
   system_node_ = Kokkos::View<LO*, MemSpace>("mpm_system_node", setup_.grid.num_nodes());
-  stencils_.nodes = decltype(stencils_.nodes)("mpm_stencil_nodes", np);
-  stencils_.g = decltype(stencils_.g)("mpm_stencil_g", np);
-  stencils_.volume = decltype(stencils_.volume)("mpm_stencil_volume", np);
-  stencils_.material = decltype(stencils_.material)("mpm_stencil_material", np);
   stencils_.materials = materials_;
+  resize_stencils();
+  n_total_ = static_cast<long long>(np);
+  ids_ = Kokkos::View<long long*, MemSpace>("mpm_particle_ids", np);
+  auto ids = ids_;
+  Kokkos::parallel_for(
+      "mpm_ids", Kokkos::RangePolicy<ExecSpace>(0, np), KOKKOS_LAMBDA(const std::size_t q) { ids(q) = q; });
   term_ = std::make_unique<MpmElasticityTerm<dim>>("mpm elasticity", stencils_);
 }
 
 template <int dim>
-LO MpmBodies<dim>::begin_step(LO first, long step) {
+void MpmBodies<dim>::resize_stencils() {
+  const std::size_t np = setup_.particles.size();
+  if (stencils_.nodes.data() != nullptr && stencils_.nodes.extent(0) == np) return;
+  stencils_.nodes = decltype(stencils_.nodes)("mpm_stencil_nodes", np);
+  stencils_.g = decltype(stencils_.g)("mpm_stencil_g", np);
+  stencils_.volume = decltype(stencils_.volume)("mpm_stencil_volume", np);
+  stencils_.material = decltype(stencils_.material)("mpm_stencil_material", np);
+}
+
+template <int dim>
+double MpmBodies<dim>::all(double v, int op) const {
+  if (!distributed_) return v;
+  double g = v;
+  Teuchos::reduceAll(*comm_, static_cast<Teuchos::EReductionType>(op), v, Teuchos::outArg(g));
+  return g;
+}
+
+template <int dim>
+void MpmBodies<dim>::distribute(const Teuchos::RCP<const Teuchos::Comm<int>>& comm, GO global_first) {
+  comm_ = comm;
+  global_first_ = global_first;
+  distributed_ = comm->getSize() > 1;
+  if (!distributed_) return;
+  replace_particles(setup_.particles);
+}
+
+template <int dim>
+void MpmBodies<dim>::replace_particles(const Particles<dim>& all) {
+  n_total_ = static_cast<long long>(all.size());
+  if (!distributed_) {
+    setup_.particles = all;
+    return;
+  }
+  slabs_ = balanced_slabs(all, setup_.grid, comm_->getSize());
+  setup_.particles = select_slab(all, slabs_, comm_->getRank(), ids_);
+  resize_stencils();
+}
+
+template <int dim>
+long long MpmBodies<dim>::migrate() {
+  if (!distributed_) return 0;
+  const long long moved = migrate_particles(setup_.particles, ids_, slabs_, *comm_);
+  if (moved > 0) resize_stencils();
+  migrated_ += moved;
+  return moved;
+}
+
+template <int dim>
+Particles<dim> MpmBodies<dim>::gathered_particles() const {
+  if (!distributed_) return setup_.particles;
+  return gather_particles(setup_.particles, ids_, n_total_, *comm_);
+}
+
+// The step's first check: every particle's stencil inside the grid, or the
+// grid grown to hold them all (a decision every rank takes together).
+template <int dim>
+void MpmBodies<dim>::check_inside_grid(long step) {
   const auto& grid = setup_.grid;
   const auto& p = setup_.particles;
   const LO out = particle_outside(grid, p);
+  double out_id = -1;
+  std::array<double, dim> pos{};
   if (out >= 0) {
-    auto x = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), p.x);
-    std::string pos;
-    bool finite = true;
-    for (int d = 0; d < dim; ++d) {
-      pos += (d ? ", " : "") + std::to_string(x(out, d));
-      finite = finite && std::isfinite(x(out, d));
-    }
-    const std::string who = "step " + std::to_string(step) + ": MPM particle " + std::to_string(out) + " at (" + pos + ")";
-    if (!setup_.extend_domain)
-      throw std::runtime_error(who + " left the grid domain (its B-spline stencil needs half a cell "
-                               "inside the grid); enlarge the scene's MPM grid domain or set "
-                               "'MPM/when particles leave: extend'");
-    if (!finite) throw std::runtime_error(who + " has a non-finite position; the grid cannot be extended to it");
-    Vec<dim> lo, hi;  // bounding box of the particles
-    for (int d = 0; d < dim; ++d) {
-      lo(d) = hi(d) = x(0, d);
-      for (std::size_t q = 0; q < x.extent(0); ++q) {
-        if (!std::isfinite(x(q, d)))
-          throw std::runtime_error("step " + std::to_string(step) + ": MPM particle " + std::to_string(q) +
-                                   " has a non-finite position; the grid cannot be extended to it");
-        lo(d) = std::min(lo(d), x(q, d));
-        hi(d) = std::max(hi(d), x(q, d));
-      }
-    }
-    int margin = 2;
-    for (int d = 0; d < dim; ++d) margin = std::max(margin, grid.n_cells[d] / 4);
-    try {
-      setup_.grid = grid_extended(grid, lo, hi, margin);
-    } catch (const std::invalid_argument& e) {
-      throw std::runtime_error(who + " left the grid domain and extending it failed: " + e.what());
-    }
-    ++extensions_;
-    system_node_ = Kokkos::View<LO*, MemSpace>("mpm_system_node", setup_.grid.num_nodes());
+    long long id = 0;
+    Kokkos::deep_copy(id, Kokkos::subview(ids_, out));
+    out_id = static_cast<double>(id);
+    auto x = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), Kokkos::subview(p.x, out, Kokkos::ALL()));
+    for (int d = 0; d < dim; ++d) pos[d] = x(d);
   }
+  if (distributed_) {  // the highest id outside, its position from its rank
+    const double mine = out_id;
+    out_id = all(mine, Teuchos::REDUCE_MAX);
+    for (int d = 0; d < dim; ++d) pos[d] = all(mine == out_id && out_id >= 0 ? pos[d] : 0.0, Teuchos::REDUCE_SUM);
+  }
+  if (out_id < 0) return;
+  std::string where;
+  bool finite = true;
+  for (int d = 0; d < dim; ++d) {
+    where += (d ? ", " : "") + std::to_string(pos[d]);
+    finite = finite && std::isfinite(pos[d]);
+  }
+  const std::string who = "step " + std::to_string(step) + ": MPM particle " +
+                          std::to_string(static_cast<long long>(out_id)) + " at (" + where + ")";
+  if (!setup_.extend_domain)
+    throw std::runtime_error(who + " left the grid domain (its B-spline stencil needs half a cell "
+                             "inside the grid); enlarge the scene's MPM grid domain or set "
+                             "'MPM/when particles leave: extend'");
+  if (!finite) throw std::runtime_error(who + " has a non-finite position; the grid cannot be extended to it");
+  // Bounding box of the particles (all ranks), and the highest id of a
+  // particle with a non-finite coordinate.
+  Vec<dim> lo, hi;
+  double bad = -1;
+  const auto ids = ids_;
+  for (int d = 0; d < dim; ++d) {
+    double l = std::numeric_limits<double>::infinity(), h = -l, b = -1;
+    const auto px = p.x;
+    Kokkos::parallel_reduce(
+        "mpm_bounding_box", Kokkos::RangePolicy<ExecSpace>(0, p.size()),
+        KOKKOS_LAMBDA(const LO q, double& a, double& z, double& nb) {
+          const double c = px(q, d);
+          if (!std::isfinite(c)) {
+            nb = static_cast<double>(ids(q)) > nb ? static_cast<double>(ids(q)) : nb;
+            return;
+          }
+          a = c < a ? c : a;
+          z = c > z ? c : z;
+        },
+        Kokkos::Min<double>(l), Kokkos::Max<double>(h), Kokkos::Max<double>(b));
+    lo(d) = all(l, Teuchos::REDUCE_MIN);
+    hi(d) = all(h, Teuchos::REDUCE_MAX);
+    bad = std::max(bad, all(b, Teuchos::REDUCE_MAX));
+  }
+  if (bad >= 0)
+    throw std::runtime_error("step " + std::to_string(step) + ": MPM particle " +
+                             std::to_string(static_cast<long long>(bad)) +
+                             " has a non-finite position; the grid cannot be extended to it");
+  int margin = 2;
+  for (int d = 0; d < dim; ++d) margin = std::max(margin, grid.n_cells[d] / 4);
+  try {
+    setup_.grid = grid_extended(grid, lo, hi, margin);
+  } catch (const std::invalid_argument& e) {
+    throw std::runtime_error(who + " left the grid domain and extending it failed: " + e.what());
+  }
+  ++extensions_;
+  system_node_ = Kokkos::View<LO*, MemSpace>("mpm_system_node", setup_.grid.num_nodes());
+}
+
+// Distributed: the active nodes renumbered owned first (in ascending global
+// id, the order activate_grid gives), then ghosts; the halo maps of the step.
+template <int dim>
+void MpmBodies<dim>::number_owned_first(LO first) {
+  using gsize = Tpetra::global_size_t;
+  const gsize invalid = Teuchos::OrdinalTraits<gsize>::invalid();
+  auto gn = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(),
+                                                Kokkos::subview(grid_node_, std::make_pair(LO(0), active_)));
+  std::vector<GO> gids(active_);
+  for (LO k = 0; k < active_; ++k) gids[k] = global_first_ + gn(k);
+  auto overlap0 = Teuchos::rcp(new Map(invalid, Teuchos::ArrayView<const GO>(gids), 0, comm_));
+  auto one = Tpetra::createOneToOne(Teuchos::RCP<const Map>(overlap0));
+  global_nodes_.clear();
+  global_nodes_.reserve(active_);
+  for (GO g : gids)
+    if (one->isNodeGlobalElement(g)) global_nodes_.push_back(g);
+  owned_ = static_cast<LO>(global_nodes_.size());
+  for (GO g : gids)
+    if (!one->isNodeGlobalElement(g)) global_nodes_.push_back(g);
+  for (LO k = 0; k < active_; ++k) gn(k) = static_cast<LO>(global_nodes_[k] - global_first_);
+  auto gnd = Kokkos::subview(grid_node_, std::make_pair(LO(0), active_));
+  Kokkos::deep_copy(gnd, gn);
+  auto sn = system_node_;
+  Kokkos::parallel_for(
+      "mpm_number_owned_first", Kokkos::RangePolicy<ExecSpace>(0, active_),
+      KOKKOS_LAMBDA(const LO k) { sn(gnd(k)) = first + k; });
+  if (!halo_) halo_ = std::make_shared<Halo>();
+  Halo& h = *halo_;
+  h.overlap = Teuchos::rcp(new Map(invalid, Teuchos::ArrayView<const GO>(global_nodes_), 0, comm_));
+  h.owned = Teuchos::rcp(new Map(invalid, Teuchos::ArrayView<const GO>(global_nodes_.data(), owned_), 0, comm_));
+  h.exporter = Teuchos::rcp(new Tpetra::Export<LO, GO, Node>(h.overlap, h.owned));
+  h.importer = Teuchos::rcp(new Tpetra::Import<LO, GO, Node>(h.owned, h.overlap));
+}
+
+// Distributed: node mass and momentum summed over the ranks holding the node.
+template <int dim>
+void MpmBodies<dim>::sum_shared_nodes() {
+  Halo& h = *halo_;
+  MultiVec ov(h.overlap, dim + 1), own(h.owned, dim + 1);
+  auto m = mass_;
+  auto mv = momentum_;
+  {
+    auto v = ov.getLocalViewDevice(Tpetra::Access::OverwriteAll);
+    Kokkos::parallel_for(
+        "mpm_halo_pack", Kokkos::RangePolicy<ExecSpace>(0, active_), KOKKOS_LAMBDA(const LO k) {
+          v(k, 0) = m(k);
+          for (int c = 0; c < dim; ++c) v(k, 1 + c) = mv(k * dim + c);
+        });
+  }
+  own.doExport(ov, *h.exporter, Tpetra::ADD);
+  ov.doImport(own, *h.importer, Tpetra::INSERT);
+  auto v = ov.getLocalViewDevice(Tpetra::Access::ReadOnly);
+  Kokkos::parallel_for(
+      "mpm_halo_unpack", Kokkos::RangePolicy<ExecSpace>(0, active_), KOKKOS_LAMBDA(const LO k) {
+        m(k) = v(k, 0);
+        for (int c = 0; c < dim; ++c) mv(k * dim + c) = v(k, 1 + c);
+      });
+}
+
+template <int dim>
+LO MpmBodies<dim>::begin_step(LO first, long step) {
+  check_inside_grid(step);
+  resize_stencils();
+  const auto& grid = setup_.grid;
+  const auto& p = setup_.particles;
   first_ = first;
   active_ = activate_grid(grid, p, first, system_node_, grid_node_);
+  if (distributed_) number_owned_first(first);
   if (static_cast<LO>(mass_.extent(0)) < active_) {
     const std::size_t cap = static_cast<std::size_t>(active_) * 5 / 4 + 16;  // grow, not per step
     mass_ = Kokkos::View<double*, MemSpace>("mpm_grid_mass", cap);
@@ -119,6 +290,7 @@ LO MpmBodies<dim>::begin_step(LO first, long step) {
   p2g(grid, p, setup_.scheme, system_node_, first, mass_scatter_, momentum_scatter_);
   Kokkos::Experimental::contribute(mass_, mass_scatter_);  // no-op for atomic, kept for portability
   Kokkos::Experimental::contribute(momentum_, momentum_scatter_);
+  if (distributed_) sum_shared_nodes();
   mpm_stencils(grid, p, system_node_, stencils_);
   bin_particles(grid, p, cells_);
   term_->set_stencils(stencils_);
@@ -196,6 +368,12 @@ typename MpmBodies<dim>::Diagnostics MpmBodies<dim>::diagnostics(const std::arra
         if (apic) l += m * D * (p.C(q, 1, 0) - p.C(q, 0, 1));
       },
       ke, el, pe, p0, p1, p2, L, M, X0, X1, X2);
+  if (distributed_) {  // every rank's particles
+    double loc[11] = {ke, el, pe, p0, p1, p2, L, M, X0, X1, X2}, glob[11];
+    Teuchos::reduceAll(*comm_, Teuchos::REDUCE_SUM, 11, loc, glob);
+    ke = glob[0], el = glob[1], pe = glob[2], p0 = glob[3], p1 = glob[4], p2 = glob[5];
+    L = glob[6], M = glob[7], X0 = glob[8], X1 = glob[9], X2 = glob[10];
+  }
   Diagnostics d;
   d.kinetic = ke;
   d.elastic = el;
@@ -265,6 +443,10 @@ std::vector<typename MpmBodies<dim>::Diagnostics> MpmBodies<dim>::body_diagnosti
   std::vector<double> sums(nb * kBodyFields, 0.0);
   Kokkos::parallel_reduce("mpm_body_diagnostics", Kokkos::RangePolicy<ExecSpace>(0, setup_.particles.size()), f,
                           sums.data());
+  if (distributed_) {  // every rank's particles
+    std::vector<double> local = sums;
+    Teuchos::reduceAll(*comm_, Teuchos::REDUCE_SUM, static_cast<int>(sums.size()), local.data(), sums.data());
+  }
   std::vector<Diagnostics> out(nb);  // (one entry for an unnamed set of particles)
   for (std::size_t b = 0; b < out.size(); ++b) {
     const double* a = sums.data() + b * kBodyFields;

@@ -3,13 +3,27 @@
 // per-step grid state that joins the Newton system (active grid nodes numbered
 // after the FEM nodes). One step: begin_step (activation, P2G, stencils),
 // fill_system (grid x^n, v^n, mass), the Newton solve, end_step (G2P).
+//
+// MPI (distribute() on more than one rank): each rank holds the particles of
+// its slab (mpm/particle_distribution.hpp) and activates the grid nodes its
+// particles touch. A grid node touched by several ranks is owned by one of
+// them (Tpetra::createOneToOne) and a ghost on the others; the active nodes
+// are numbered owned first, then ghosts (the order DofSpace::set_partition
+// expects), and P2G's partial sums at shared nodes are added at the owner
+// (Export, ADD) and copied back to every holder (Import), so every rank sees
+// the whole mass and momentum of each of its nodes. G2P then needs only local
+// nodes; particles that left the slab migrate at the end of the step.
 #include <Kokkos_ScatterView.hpp>
 #include <memory>
 #include <string>
 #include <vector>
 
+#include <Teuchos_Comm.hpp>
+#include <Teuchos_RCP.hpp>
+
 #include "kernels/mpm_transfer.hpp"
 #include "mpm/particle_cells.hpp"
+#include "mpm/particle_distribution.hpp"
 #include "solver/energy_term.hpp"
 
 namespace bfemp {
@@ -73,7 +87,31 @@ class MpmBodies {
                 Kokkos::View<const double*, MemSpace> v_old);
 
   const MpmElasticityTerm<dim>& term() const { return *term_; }
+  // This rank's particles (all of them on one rank).
   const Particles<dim>& particles() const { return setup_.particles; }
+
+  // MPI: cut the particles into slabs and keep this rank's (every rank has
+  // the scene's whole set here); grid nodes get the global system ids
+  // global_first + grid index. No-op on one rank.
+  void distribute(const Teuchos::RCP<const Teuchos::Comm<int>>& comm, GO global_first);
+  bool distributed() const { return distributed_; }
+  // Restart: the whole particle set of a checkpoint (re-cut when distributed).
+  void replace_particles(const Particles<dim>& all);
+  // Particles that left this rank's slab go to their owners (collective; at
+  // the end of a step). Returns the number moved over all ranks.
+  long long migrate();
+  long long migrated_particles() const { return migrated_; }  // since construction, all ranks
+  // Particles on all ranks; each particle's global id (its scene index).
+  long long total_particles() const { return n_total_; }
+  Kokkos::View<const long long*, MemSpace> particle_ids() const { return ids_; }
+  // All particles in id order on rank 0 (collective; empty elsewhere; the
+  // rank's own set on one rank, without a copy).
+  Particles<dim> gathered_particles() const;
+  // Active nodes owned by this rank (the first ones) and the global system
+  // id of every active node (distributed; empty on one rank).
+  LO owned_nodes() const { return distributed_ ? owned_ : active_; }
+  const std::vector<GO>& global_nodes() const { return global_nodes_; }
+  const ParticleSlabs<dim>& slabs() const { return slabs_; }
   const GridSpec<dim>& grid() const { return setup_.grid; }
   TransferScheme scheme() const { return setup_.scheme; }
   LO active_nodes() const { return active_; }
@@ -116,6 +154,22 @@ class MpmBodies {
   std::unique_ptr<MpmElasticityTerm<dim>> term_;
   LO first_ = 0, active_ = 0;
   int extensions_ = 0;
+  // MPI
+  Teuchos::RCP<const Teuchos::Comm<int>> comm_;
+  bool distributed_ = false;
+  GO global_first_ = 0;
+  ParticleSlabs<dim> slabs_;
+  Kokkos::View<long long*, MemSpace> ids_;
+  long long n_total_ = 0, migrated_ = 0;
+  LO owned_ = 0;
+  std::vector<GO> global_nodes_;
+  struct Halo;
+  std::shared_ptr<Halo> halo_;
+  void resize_stencils();
+  void check_inside_grid(long step);
+  void number_owned_first(LO first);
+  void sum_shared_nodes();
+  double all(double v, int op) const;
 };
 
 }  // namespace bfemp

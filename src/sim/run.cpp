@@ -185,7 +185,7 @@ RunSummary run_dim(const Scene& scene, const std::string& dir, const Teuchos::RC
   log << "FEM: " << mesh.num_nodes() << " nodes, " << mesh.num_cells() << " elements, "
       << mesh.num_nodes() * dim << " DOFs";
   if (const auto* mpm = sim.mpm())
-    log << "; MPM: " << mpm->particles().size() << " particles, " << transfer_scheme_name(mpm->scheme())
+    log << "; MPM: " << mpm->total_particles() << " particles, " << transfer_scheme_name(mpm->scheme())
         << ", grid " << mpm->grid().num_nodes() << " nodes (dx " << mpm->grid().dx << ")";
   log << "; linear solver: " << sim.newton().linear_solver().describe() << "\n";
   if (const FemPartition* part = sim.partition()) {
@@ -201,6 +201,21 @@ RunSummary run_dim(const Scene& scene, const std::string& dir, const Teuchos::RC
         << "), owned DOFs per rank " << lo[1] << ".." << hi[1] << " (imbalance " << hi[1] / (sum[1] / n)
         << ")\n" << std::setprecision(6);
   }
+  if (const auto* mpm = sim.mpm(); mpm && mpm->distributed()) {
+    // Per-rank particles (assembly, transfers); imbalance = max / mean.
+    const double mine = static_cast<double>(mpm->particles().size());
+    double lo = 0, hi = 0, sum = 0;
+    Teuchos::reduceAll(*comm, Teuchos::REDUCE_MIN, mine, Teuchos::outArg(lo));
+    Teuchos::reduceAll(*comm, Teuchos::REDUCE_MAX, mine, Teuchos::outArg(hi));
+    Teuchos::reduceAll(*comm, Teuchos::REDUCE_SUM, mine, Teuchos::outArg(sum));
+    const int n = comm->getSize();
+    auto cuts = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), mpm->slabs().cuts);
+    std::ostringstream c;
+    for (std::size_t k = 0; k < cuts.extent(0); ++k) c << (k ? ", " : "") << cuts(k);
+    log << "MPI: " << n << " ranks (MPM particles in slabs along axis " << mpm->slabs().axis << ", cuts at " << c.str()
+        << " m; particles migrate between slabs): particles per rank " << lo << ".." << hi << " (imbalance "
+        << std::setprecision(3) << hi / (sum / n) << ")\n" << std::setprecision(6);
+  }
   {
     std::string names;
     for (const auto& n : sim.term_names()) names += (names.empty() ? "" : ", ") + n;
@@ -210,21 +225,31 @@ RunSummary run_dim(const Scene& scene, const std::string& dir, const Teuchos::RC
   if (opt.restart && opt.append) resume = {opt.restart->frames, opt.restart->step};
   // A new output must not keep an older run's checkpoint: restarting from it
   // would mix that run's state with this run's frames.
-  // Rank 0 writes every file (the state is replicated).
+  // Rank 0 writes every file (the FEM state is replicated; MPM particles are
+  // gathered to it for each frame and checkpoint).
   if (root && !(opt.restart && opt.append)) std::filesystem::remove(dir + "/checkpoint.h5");
   std::unique_ptr<RunOutput<dim>> out_ptr;
   if (root) out_ptr = std::make_unique<RunOutput<dim>>(dir, scene, sim, opt.restart && opt.append ? &resume : nullptr);
-  if (root && !(opt.restart && opt.append)) out_ptr->write_frame(sim);
   if (opt.restart)
     log << "restart: from step " << opt.restart->step << " (t = " << opt.restart->time << " s), "
         << (opt.append ? "appending to " : "new output in ") << dir << "\n";
   const std::string ck_path = dir + "/checkpoint.h5";
   RunSummary s;
   s.contact = sim.contact() != nullptr;
-  auto checkpoint = [&] {
-    if (root) write_checkpoint(ck_path, make_checkpoint(scene, opt, sim, out_ptr->frames_written()));
+  auto checkpoint = [&] {  // collective (MPI MPM: the particles gathered to rank 0)
+    const Checkpoint c = make_checkpoint(scene, opt, sim, root ? out_ptr->frames_written() : 0);
+    if (root) write_checkpoint(ck_path, c);
     s.checkpoints++;
   };
+  auto write_frame = [&] {  // collective, as the checkpoint
+    if (sim.mpm() && sim.mpm()->distributed()) {
+      const Particles<dim> all = sim.mpm()->gathered_particles();
+      if (root) out_ptr->write_frame(sim, &all);
+    } else if (root) {
+      out_ptr->write_frame(sim);
+    }
+  };
+  if (!(opt.restart && opt.append)) write_frame();  // frame 0: the initial state
   const double dt = scene.params.sublist("Time").get<double>("dt");
   const long n_steps = static_cast<long>(std::ceil(rc.end_time / dt - 1e-9));
   const long first = sim.step_index();
@@ -251,7 +276,7 @@ RunSummary run_dim(const Scene& scene, const std::string& dir, const Teuchos::RC
     // A signal during the last step: the run is complete; finish normally.
     const int sig = guard && n + 1 < n_steps ? global_signal(comm) : 0;
     const bool framed = (n + 1) % rc.output_every == 0 || n + 1 == n_steps || sig;
-    if (framed && root) out_ptr->write_frame(sim);
+    if (framed) write_frame();
     if (sig || (checkpoint_every > 0 && (n + 1) % checkpoint_every == 0 && n + 1 < n_steps)) checkpoint();
     if (rc.progress_every > 0 && ((n + 1) % rc.progress_every == 0 || n + 1 == n_steps)) {
       const double el = wall.seconds();

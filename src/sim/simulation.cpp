@@ -49,13 +49,25 @@ Simulation<dim>::Simulation(SimulationSetup<dim> setup, const Teuchos::RCP<const
     mpm_min_particle_mass_ = std::isfinite(m) ? m : 0.0;
   }
   comm_ = comm;
-  if (comm->getSize() > 1 && setup_.mpm)
-    throw std::invalid_argument("this scene has MPM bodies, which run on 1 MPI rank in this version (the "
-                                "distributed particles and grid are not built yet); this run has " +
-                                std::to_string(comm->getSize()) + " ranks: run it without mpirun or with -np 1");
+  if (comm->getSize() > 1 && setup_.mpm) {
+    if (mesh_.num_nodes() > 0)
+      throw std::invalid_argument("this scene has MPM and FEM bodies; on several MPI ranks this version runs "
+                                  "scenes of MPM bodies alone or of FEM bodies alone (this run has " +
+                                  std::to_string(comm->getSize()) + " ranks): run it without mpirun or with -np 1");
+    for (const auto& ls : setup_.level_sets)
+      if (ls.slip)
+        throw std::invalid_argument("level set '" + ls.name + "': 'slip: true' runs on 1 MPI rank in this version "
+                                    "(this run has " + std::to_string(comm->getSize()) +
+                                    " ranks): run it without mpirun or with -np 1, or make it no-slip");
+    // Each rank keeps the particles of its slab; the grid is shared.
+    mpm_->distribute(comm, 0);
+    mpm_distributed_ = true;
+    double m = mpm_min_particle_mass_;
+    Teuchos::reduceAll(*comm, Teuchos::REDUCE_MIN, m, Teuchos::outArg(mpm_min_particle_mass_));
+  }
   newton_ = std::make_unique<NewtonSolver<dim>>(comm, setup_.linear_solver, setup_.newton);
   sys_ = std::make_unique<System>();
-  if (comm->getSize() > 1) {
+  if (comm->getSize() > 1 && !setup_.mpm) {
     // FEM only: cut the elements into the ranks; Newton runs on this rank's piece.
     distributed_ = true;
     part_ = partition_fem_mesh<dim>(mesh_, comm);
@@ -219,11 +231,15 @@ void Simulation<dim>::prescribed_velocities(double t1) {
 // weight), since their direction is round-off.
 namespace {
 void hold_massless_grid_nodes(std::size_t first, std::size_t n, View1 x, View1 v, View1 mass, View1 target,
-                              Kokkos::View<int*, MemSpace> pres) {
+                              Kokkos::View<int*, MemSpace> pres, const Comm& comm) {
   double mmax = 0;
   Kokkos::parallel_reduce(
       "grid_mass_max", Kokkos::RangePolicy<ExecSpace>(first, n),
       KOKKOS_LAMBDA(const std::size_t i, double& m) { m = mass(i) > m ? mass(i) : m; }, Kokkos::Max<double>(mmax));
+  if (comm.getSize() > 1) {  // the heaviest node of all ranks (the same floor everywhere)
+    const double mine = mmax;
+    Teuchos::reduceAll(comm, Teuchos::REDUCE_MAX, mine, Teuchos::outArg(mmax));
+  }
   const double floor = 1e-12 * mmax;
   Kokkos::parallel_for(
       "grid_hold_massless", Kokkos::RangePolicy<ExecSpace>(first, n), KOKKOS_LAMBDA(const std::size_t i) {
@@ -273,7 +289,7 @@ StepReport Simulation<dim>::step() {
     auto grid_part = std::make_pair(nfd, nd);
     Kokkos::deep_copy(Kokkos::subview(pres, grid_part), 0);
     mpm_->fill_system(x, v, mass);
-    hold_massless_grid_nodes(nfd, nd, x, v, mass, target, pres);
+    hold_massless_grid_nodes(nfd, nd, x, v, mass, target, pres, *comm_);
     apply_level_sets<dim>(level_sets_, time_, dt, nfd, nd, x, v, target, pres);
     newton_->slip_constraints().build(level_sets_, time_, dt, nfd, nd, x, v, pres);  // slip: n . v = n . v_b
     terms.push_back(&mpm_->term());
@@ -282,6 +298,7 @@ StepReport Simulation<dim>::step() {
       terms.push_back(contact_->barrier());
       if (contact_->has_friction()) terms.push_back(contact_->friction());
     }
+    if (mpm_distributed_) newton_->set_partition(mpm_->global_nodes(), mpm_->owned_nodes());
     graph_rebuilt = newton_->set_system(nF + nA, terms);
     // Grid a^n = g - M^-1 grad Psi(x^n): the Newmark predictor and velocity
     // update need it; backward Euler (no a^n term in either) does not.
@@ -290,6 +307,7 @@ StepReport Simulation<dim>::step() {
       auto work = System::head(S.work, nd);
       Kokkos::deep_copy(work, 0.0);
       newton_->potential_gradient(x, -1.0, work);
+      newton_->sum_shared(work);  // MPI: this rank's particles' share, summed at shared nodes
       Kokkos::parallel_for(
           "grid_a0", Kokkos::RangePolicy<ExecSpace>(off, nd),
           KOKKOS_LAMBDA(const std::size_t i) { a(i) = mass(i) > 0 ? work(i) / mass(i) + g[i % dim] : 0.0; });
@@ -341,7 +359,8 @@ StepReport Simulation<dim>::step() {
   // of 4e-3). A step that fails so is redone from its start with the
   // projected Hessian, which converges there.
   const bool can_retry = newton_->hessian_mode() == HessianMode::ExactIfDefinite &&
-                         newton_->linear_solver().kind() == LinearSolverKind::Cholmod && !distributed_;
+                         newton_->linear_solver().kind() == LinearSolverKind::Cholmod && !distributed_ &&
+                         !mpm_distributed_;
   auto x_start = System::head(S.x_start, nd);
   if (can_retry) Kokkos::deep_copy(x_start, x);
   try {
@@ -392,12 +411,14 @@ StepReport Simulation<dim>::step() {
   Kokkos::deep_copy(v_, Kokkos::subview(v, fem));
   Kokkos::deep_copy(a_, Kokkos::subview(a, fem));
   prescribed_velocities(t1);
-  if (mpm_) mpm_->end_step(x, v, v_old);
+  if (mpm_) {
+    mpm_->end_step(x, v, v_old);
+    mpm_->migrate();  // MPI: particles that left this rank's slab
+  }
   time_ = t1;
   ++step_;
   StepReport r = diagnostics();
   r.newton = ns;
-  r.active_grid_nodes = nA;
   if (contact_) {
     r.contact_pairs = contact_report.pairs;
     r.min_distance = contact_report.min_distance;
@@ -476,6 +497,12 @@ void Simulation<dim>::count_penetrations(StepReport& r) {
         }
       },
       ls_count, Kokkos::Max<double>(depth));
+  if (mpm_distributed_) {  // every rank's particles (no FEM bodies on several ranks)
+    const long n = ls_count;
+    const double d = depth;
+    Teuchos::reduceAll(*comm_, Teuchos::REDUCE_SUM, n, Teuchos::outArg(ls_count));
+    Teuchos::reduceAll(*comm_, Teuchos::REDUCE_MAX, d, Teuchos::outArg(depth));
+  }
   r.penetrations = fem_count + ls_count;
   r.penetration_depth = ls_count > 0 ? depth : 0.0;  // (the Max reducer starts at -DBL_MAX)
 }
@@ -572,8 +599,16 @@ StepReport Simulation<dim>::diagnostics() const {
       for (int c = 0; c < 3; ++c) r.momentum[c] += d.momentum[c];
       r.angular_momentum_z += d.angular;
     }
-    r.min_J = std::min(r.min_J, mpm_particle_min_J(mpm_->particles()));
-    r.active_grid_nodes = mpm_->active_nodes();
+    double mpm_J = mpm_particle_min_J(mpm_->particles());
+    long long grid_nodes = mpm_->owned_nodes();
+    if (mpm_distributed_) {  // all ranks' particles; each grid node counted at its owner
+      const double j = mpm_J;
+      const long long g = grid_nodes;
+      Teuchos::reduceAll(*comm_, Teuchos::REDUCE_MIN, j, Teuchos::outArg(mpm_J));
+      Teuchos::reduceAll(*comm_, Teuchos::REDUCE_SUM, g, Teuchos::outArg(grid_nodes));
+    }
+    r.min_J = std::min(r.min_J, mpm_J);
+    r.active_grid_nodes = grid_nodes;
   }
   for (const auto& b : mesh_.bodies) {
     BodyReport br;

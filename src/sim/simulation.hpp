@@ -165,7 +165,8 @@ class Simulation {
   // MPI: the partition, this rank's elasticity (local node ids), the global
   // DOF of each local DOF, and the local copies of the step's inputs.
   Teuchos::RCP<const Comm> comm_;
-  bool distributed_ = false;
+  bool distributed_ = false;      // FEM bodies only, elements cut into the ranks
+  bool mpm_distributed_ = false;  // MPM bodies only, particles cut into slabs (MpmBodies::distribute)
   FemPartition part_;
   std::unique_ptr<DeformationTerm<dim, dim + 1>> local_elasticity_;
   Kokkos::View<LO*, MemSpace> local_dof_;

@@ -44,7 +44,9 @@ SimulationState<dim> Simulation<dim>::state() const {
   s.fem_v = to_host(v_);
   s.fem_a = to_host(a_);
   if (mpm_) {
-    const auto& p = mpm_->particles();
+    // MPI: every rank's particles, in id order, on rank 0 (collective; the
+    // other ranks' state carries no particles).
+    const Particles<dim> p = mpm_->gathered_particles();
     s.has_mpm = true;
     s.x = to_host(p.x);
     s.v = to_host(p.v);
@@ -74,7 +76,13 @@ void Simulation<dim>::restore(const SimulationState<dim>& s) {
   from_host(v_, s.fem_v, "fem_v");
   from_host(a_, s.fem_a, "fem_a");
   if (mpm_) {
-    const auto& p = mpm_->particles();
+    // The checkpoint's whole particle set (MPI: each rank then keeps its slab).
+    const std::size_t np = s.mass.size();
+    if (static_cast<long long>(np) != mpm_->total_particles())
+      throw std::invalid_argument("restart: checkpoint field 'particle_mass' has " + std::to_string(np) +
+                                  " values, the scene's state has " + std::to_string(mpm_->total_particles()) +
+                                  " (is this the checkpoint's scene?)");
+    const Particles<dim> p = allocate_particles<dim>(np);
     from_host(p.x, s.x, "particle_x");
     from_host(p.v, s.v, "particle_v");
     from_host(p.mass, s.mass, "particle_mass");
@@ -83,6 +91,8 @@ void Simulation<dim>::restore(const SimulationState<dim>& s) {
     from_host(p.C, s.C, "particle_C");
     from_host(p.body, s.body, "particle_body");
     from_host(p.material, s.material, "particle_material");
+    Kokkos::fence();
+    mpm_->replace_particles(p);
     GridSpec<dim> g;
     for (int d = 0; d < dim; ++d) {
       g.origin(d) = s.grid_origin[d];

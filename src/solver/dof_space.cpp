@@ -200,6 +200,18 @@ void DofSpace<dim>::to_local(const Vector& owned, DofView local) {
   Kokkos::deep_copy(local, v);
 }
 
+template <int dim>
+void DofSpace<dim>::sum_shared(DofView local) {
+  if (!distributed()) return;
+  {
+    auto rv = Kokkos::subview(rhs_overlap_->getLocalViewDevice(Tpetra::Access::OverwriteAll), Kokkos::ALL(), 0);
+    Kokkos::deep_copy(rv, local);
+  }
+  Vector owned(map_);
+  owned.doExport(*rhs_overlap_, *export_, Tpetra::ADD);
+  to_local(owned, local);
+}
+
 template class DofSpace<2>;
 template class DofSpace<3>;
 

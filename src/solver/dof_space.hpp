@@ -79,6 +79,10 @@ class DofSpace {
   void end_assembly(MaskView prescribed, ConstDofView dx_prescribed, DofView rhs, Vector& b);
   // The owned vector's values at every local DOF (owned and ghost).
   void to_local(const Vector& owned, DofView local);
+  // Distributed: each DOF's values summed over the ranks that hold it, the
+  // sum at every holder (a term's gradient assembled rank by rank). No-op on
+  // one rank. After set_structure.
+  void sum_shared(DofView local);
 
   SlipConstraints<dim>& slip() { return slip_; }
   const SlipConstraints<dim>& slip() const { return slip_; }

@@ -197,6 +197,11 @@ void NewtonSolver<dim>::potential_gradient(CView1 x, double scale, View1 grad) c
 }
 
 template <int dim>
+void NewtonSolver<dim>::sum_shared(View1 v) {
+  impl_->dofs.sum_shared(v);
+}
+
+template <int dim>
 typename NewtonSolver<dim>::Energy NewtonSolver<dim>::energy(const IncrementalPotential& ip,
                                                              CView1 x) const {
   Energy E;

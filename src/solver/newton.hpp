@@ -110,6 +110,9 @@ class NewtonSolver {
   double potential(Kokkos::View<const double*, MemSpace> x) const;
   void potential_gradient(Kokkos::View<const double*, MemSpace> x, double scale,
                           Kokkos::View<double*, MemSpace> grad) const;
+  // Distributed: a rank-by-rank assembled vector (potential_gradient) summed
+  // at every DOF over the ranks holding it (DofSpace::sum_shared).
+  void sum_shared(Kokkos::View<double*, MemSpace> v);
 
   // Called after every accepted Newton iterate (debug checks, tests).
   std::function<void(Kokkos::View<const double*, MemSpace>)> on_iterate;

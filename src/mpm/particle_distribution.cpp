@@ -1,0 +1,250 @@
+#include "mpm/particle_distribution.hpp"
+
+#include <Teuchos_CommHelpers.hpp>
+#include <Teuchos_DefaultMpiComm.hpp>
+#include <algorithm>
+#include <cmath>
+#include <mpi.h>
+#include <stdexcept>
+
+namespace bfemp {
+
+namespace {
+
+// Doubles per packed particle: id, x, v, mass, volume0, F, C, body, material
+// (ids and indices are exact in a double below 2^53).
+template <int dim>
+constexpr int kFields = 1 + 2 * dim + 2 + 2 * dim * dim + 2;
+
+MPI_Comm raw(const Teuchos::Comm<int>& comm) {
+  const auto* m = dynamic_cast<const Teuchos::MpiComm<int>*>(&comm);
+  if (!m) throw std::logic_error("particle distribution: the communicator is not an MPI one");
+  return (*m->getRawMpiComm())();
+}
+
+// buf(k, :) = particle order(k) of p.
+template <int dim>
+void pack(const Particles<dim>& p, Kokkos::View<const long long*, MemSpace> ids, Kokkos::View<const LO*, MemSpace> order,
+          Kokkos::View<double**, Kokkos::LayoutRight, MemSpace> buf) {
+  Kokkos::parallel_for(
+      "mpm_pack_particles", Kokkos::RangePolicy<ExecSpace>(0, order.extent(0)), KOKKOS_LAMBDA(const LO k) {
+        const LO q = order(k);
+        int f = 0;
+        buf(k, f++) = static_cast<double>(ids(q));
+        for (int c = 0; c < dim; ++c) buf(k, f++) = p.x(q, c);
+        for (int c = 0; c < dim; ++c) buf(k, f++) = p.v(q, c);
+        buf(k, f++) = p.mass(q);
+        buf(k, f++) = p.volume0(q);
+        for (int i = 0; i < dim; ++i)
+          for (int j = 0; j < dim; ++j) buf(k, f++) = p.F(q, i, j);
+        for (int i = 0; i < dim; ++i)
+          for (int j = 0; j < dim; ++j) buf(k, f++) = p.C(q, i, j);
+        buf(k, f++) = p.body(q);
+        buf(k, f++) = p.material(q);
+      });
+}
+
+// Rows [0, n) of buf into p at rows offset + k (by_id: at row id - offset).
+template <int dim>
+void unpack(Kokkos::View<const double**, Kokkos::LayoutRight, MemSpace> buf, std::size_t n, const Particles<dim>& p,
+            Kokkos::View<long long*, MemSpace> ids, std::size_t offset, bool by_id) {
+  Kokkos::parallel_for(
+      "mpm_unpack_particles", Kokkos::RangePolicy<ExecSpace>(0, n), KOKKOS_LAMBDA(const std::size_t k) {
+        int f = 0;
+        const long long id = static_cast<long long>(buf(k, f++));
+        const std::size_t q = by_id ? static_cast<std::size_t>(id) : offset + k;
+        if (ids.extent(0) > 0) ids(q) = id;
+        for (int c = 0; c < dim; ++c) p.x(q, c) = buf(k, f++);
+        for (int c = 0; c < dim; ++c) p.v(q, c) = buf(k, f++);
+        p.mass(q) = buf(k, f++);
+        p.volume0(q) = buf(k, f++);
+        for (int i = 0; i < dim; ++i)
+          for (int j = 0; j < dim; ++j) p.F(q, i, j) = buf(k, f++);
+        for (int i = 0; i < dim; ++i)
+          for (int j = 0; j < dim; ++j) p.C(q, i, j) = buf(k, f++);
+        p.body(q) = static_cast<int>(buf(k, f++));
+        p.material(q) = static_cast<int>(buf(k, f++));
+      });
+}
+
+// Particles grouped by destination rank: order lists the particles of rank
+// `first` first, then ranks 0, 1, ... (skipping `first`); count[r] per rank.
+template <int dim>
+Kokkos::View<LO*, MemSpace> group_by_owner(const Particles<dim>& p, const ParticleSlabs<dim>& s, int first,
+                                           std::vector<long long>& count) {
+  const LO np = static_cast<LO>(p.size());
+  Kokkos::View<int*, MemSpace> dest("mpm_particle_dest", np);
+  const auto px = p.x;
+  const int axis = s.axis;
+  Kokkos::parallel_for(
+      "mpm_particle_owner", Kokkos::RangePolicy<ExecSpace>(0, np),
+      KOKKOS_LAMBDA(const LO q) { dest(q) = s.owner(px(q, axis)); });
+  Kokkos::View<LO*, MemSpace> order("mpm_particle_order", np);
+  count.assign(s.nranks, 0);
+  LO offset = 0;
+  for (int k = -1; k < s.nranks; ++k) {
+    const int r = k < 0 ? first : k;
+    if (k >= 0 && r == first) continue;
+    LO n = 0;
+    const LO base = offset;
+    Kokkos::parallel_scan(
+        "mpm_group_by_owner", Kokkos::RangePolicy<ExecSpace>(0, np),
+        KOKKOS_LAMBDA(const LO q, LO& pos, const bool final) {
+          if (dest(q) != r) return;
+          if (final) order(base + pos) = q;
+          ++pos;
+        },
+        n);
+    count[r] = n;
+    offset += n;
+  }
+  return order;
+}
+
+using Buffer = Kokkos::View<double**, Kokkos::LayoutRight, MemSpace>;
+
+}  // namespace
+
+template <int dim>
+ParticleSlabs<dim> balanced_slabs(const Particles<dim>& all, const GridSpec<dim>& grid, int nranks) {
+  ParticleSlabs<dim> s;
+  s.nranks = nranks;
+  for (int d = 1; d < dim; ++d)
+    if (grid.n_cells[d] > grid.n_cells[s.axis]) s.axis = d;
+  auto x = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), all.x);
+  std::vector<double> c(x.extent(0));
+  for (std::size_t q = 0; q < c.size(); ++q) c[q] = x(q, s.axis);
+  std::sort(c.begin(), c.end());
+  const double o = grid.origin(s.axis), dx = grid.dx;
+  std::vector<double> cuts;
+  for (int r = 1; r < nranks; ++r) {
+    double cut = -std::numeric_limits<double>::infinity();
+    if (!c.empty()) {
+      const std::size_t k = std::min(c.size() - 1, c.size() * r / nranks);
+      cut = o + dx * std::round((c[k] - o) / dx);  // the nearest cell face
+    }
+    if (!cuts.empty()) cut = std::max(cut, cuts.back());
+    cuts.push_back(cut);
+  }
+  s.cuts = Kokkos::View<double*, MemSpace>("mpm_slab_cuts", std::max(nranks - 1, 0));
+  auto h = Kokkos::create_mirror_view(s.cuts);
+  for (int r = 0; r + 1 < nranks; ++r) h(r) = cuts[r];
+  Kokkos::deep_copy(s.cuts, h);
+  return s;
+}
+
+template <int dim>
+Particles<dim> select_slab(const Particles<dim>& all, const ParticleSlabs<dim>& slabs, int rank,
+                           Kokkos::View<long long*, MemSpace>& ids) {
+  const LO np = static_cast<LO>(all.size());
+  Kokkos::View<long long*, MemSpace> all_ids("mpm_particle_ids_all", np);
+  Kokkos::parallel_for(
+      "mpm_ids_identity", Kokkos::RangePolicy<ExecSpace>(0, np), KOKKOS_LAMBDA(const LO q) { all_ids(q) = q; });
+  std::vector<long long> count;
+  auto order = group_by_owner(all, slabs, rank, count);
+  const LO mine = static_cast<LO>(count[rank]);
+  Buffer buf("mpm_select_buffer", mine, kFields<dim>);
+  pack<dim>(all, all_ids, Kokkos::subview(order, std::make_pair(LO(0), mine)), buf);
+  Particles<dim> out = allocate_particles<dim>(mine);
+  ids = Kokkos::View<long long*, MemSpace>("mpm_particle_ids", mine);
+  unpack<dim>(buf, mine, out, ids, 0, false);
+  Kokkos::fence();
+  return out;
+}
+
+template <int dim>
+long long migrate_particles(Particles<dim>& p, Kokkos::View<long long*, MemSpace>& ids, const ParticleSlabs<dim>& slabs,
+                            const Teuchos::Comm<int>& comm) {
+  const int me = comm.getRank(), n = comm.getSize();
+  if (n == 1) return 0;
+  std::vector<long long> count;
+  auto order = group_by_owner(p, slabs, me, count);
+  const long long np = static_cast<long long>(p.size());
+  long long leaving = np - count[me], moved = 0;
+  Teuchos::reduceAll(comm, Teuchos::REDUCE_SUM, leaving, Teuchos::outArg(moved));
+  if (moved == 0) return 0;
+  constexpr int nf = kFields<dim>;
+  Buffer buf("mpm_migrate_buffer", np, nf);
+  pack<dim>(p, ids, order, buf);
+  auto hb = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), buf);
+  // Send counts (in doubles) and displacements into hb: rank me's own rows
+  // come first, then ranks 0, 1, ... without me.
+  std::vector<int> scount(n, 0), sdisp(n, 0), rcount(n, 0), rdisp(n, 0);
+  long long row = count[me];
+  for (int r = 0; r < n; ++r) {
+    if (r == me) continue;
+    scount[r] = static_cast<int>(count[r] * nf);
+    sdisp[r] = static_cast<int>(row * nf);
+    row += count[r];
+  }
+  MPI_Comm c = raw(comm);
+  MPI_Alltoall(scount.data(), 1, MPI_INT, rcount.data(), 1, MPI_INT, c);
+  long long recv = 0;
+  for (int r = 0; r < n; ++r) {
+    rdisp[r] = static_cast<int>(recv);
+    recv += rcount[r];
+  }
+  Kokkos::View<double**, Kokkos::LayoutRight, Kokkos::HostSpace> hr("mpm_migrate_recv", recv / nf, nf);
+  MPI_Alltoallv(hb.data(), scount.data(), sdisp.data(), MPI_DOUBLE, hr.data(), rcount.data(), rdisp.data(),
+                MPI_DOUBLE, c);
+  const std::size_t kept = static_cast<std::size_t>(count[me]), arrived = static_cast<std::size_t>(recv / nf);
+  Particles<dim> out = allocate_particles<dim>(kept + arrived);
+  Kokkos::View<long long*, MemSpace> out_ids("mpm_particle_ids", kept + arrived);
+  unpack<dim>(Kokkos::subview(buf, std::make_pair(std::size_t(0), kept), Kokkos::ALL()), kept, out, out_ids, 0, false);
+  if (arrived > 0) {
+    auto rb = Kokkos::create_mirror_view_and_copy(MemSpace(), hr);
+    unpack<dim>(rb, arrived, out, out_ids, kept, false);
+  }
+  Kokkos::fence();
+  p = out;
+  ids = out_ids;
+  return moved;
+}
+
+template <int dim>
+Particles<dim> gather_particles(const Particles<dim>& p, Kokkos::View<const long long*, MemSpace> ids,
+                                long long n_total, const Teuchos::Comm<int>& comm, int root) {
+  const int me = comm.getRank(), n = comm.getSize();
+  constexpr int nf = kFields<dim>;
+  const LO np = static_cast<LO>(p.size());
+  Kokkos::View<LO*, MemSpace> order("mpm_gather_order", np);
+  Kokkos::parallel_for(
+      "mpm_gather_identity", Kokkos::RangePolicy<ExecSpace>(0, np), KOKKOS_LAMBDA(const LO q) { order(q) = q; });
+  Buffer buf("mpm_gather_buffer", np, nf);
+  pack<dim>(p, ids, order, buf);
+  auto hb = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), buf);
+  int mine = static_cast<int>(np) * nf;
+  std::vector<int> counts(n, 0), disp(n, 0);
+  MPI_Comm c = raw(comm);
+  MPI_Gather(&mine, 1, MPI_INT, counts.data(), 1, MPI_INT, root, c);
+  long long total = 0;
+  for (int r = 0; r < n; ++r) {
+    disp[r] = static_cast<int>(total);
+    total += counts[r];
+  }
+  if (me == root && total != n_total * nf)
+    throw std::logic_error("gather_particles: " + std::to_string(total / nf) + " particles on the ranks, expected " +
+                           std::to_string(n_total));
+  Kokkos::View<double**, Kokkos::LayoutRight, Kokkos::HostSpace> hr("mpm_gather_recv", me == root ? n_total : 0, nf);
+  MPI_Gatherv(hb.data(), mine, MPI_DOUBLE, hr.data(), counts.data(), disp.data(), MPI_DOUBLE, root, c);
+  if (me != root) return allocate_particles<dim>(0);
+  Particles<dim> out = allocate_particles<dim>(n_total);
+  auto rb = Kokkos::create_mirror_view_and_copy(MemSpace(), hr);
+  unpack<dim>(rb, n_total, out, Kokkos::View<long long*, MemSpace>(), 0, true);
+  Kokkos::fence();
+  return out;
+}
+
+#define BFEMP_INSTANTIATE(D)                                                                                        \
+  template ParticleSlabs<D> balanced_slabs<D>(const Particles<D>&, const GridSpec<D>&, int);                        \
+  template Particles<D> select_slab<D>(const Particles<D>&, const ParticleSlabs<D>&, int,                          \
+                                       Kokkos::View<long long*, MemSpace>&);                                        \
+  template long long migrate_particles<D>(Particles<D>&, Kokkos::View<long long*, MemSpace>&,                      \
+                                          const ParticleSlabs<D>&, const Teuchos::Comm<int>&);                      \
+  template Particles<D> gather_particles<D>(const Particles<D>&, Kokkos::View<const long long*, MemSpace>, long long, \
+                                            const Teuchos::Comm<int>&, int);
+BFEMP_INSTANTIATE(2)
+BFEMP_INSTANTIATE(3)
+#undef BFEMP_INSTANTIATE
+
+}  // namespace bfemp

@@ -1,0 +1,65 @@
+#pragma once
+// The MPM particles cut into the ranks of a communicator: slabs along one
+// axis of the grid (the one with the most cells), each rank owning the
+// particles whose coordinate on that axis lies in its slab,
+//   rank r owns x_axis in [cut_{r-1}, cut_r)   (cut_{-1} = -inf, cut_{R-1} = +inf),
+// with the cuts at cell faces (origin + dx k) chosen so that every slab holds
+// about the same number of particles when the cuts are made. A slab keeps its
+// cuts (fixed in space, not in grid index: they survive grid extensions); a
+// particle that leaves its slab migrates to the owning rank at the end of the
+// step (migrate_particles: one all-to-all exchange, fields packed on device).
+// Why slabs and not Zoltan2 boxes: one cut coordinate per rank pair makes the
+// owner of a position a kernel-side comparison, and for the 2-64 ranks of the
+// scenes in view a slab's halo (one node layer each side) stays small; the
+// cost is a halo that grows with the cross-section instead of the surface.
+//
+// Every particle has a global id (its index in the scene's particle list),
+// carried through every migration: output and checkpoints gather the
+// particles to rank 0 in id order, so a run on R ranks writes the same files
+// as one on 1 rank. One rank: nothing moves, ids are 0..n-1.
+#include <Kokkos_Core.hpp>
+#include <Teuchos_Comm.hpp>
+#include <vector>
+
+#include "mpm/grid.hpp"
+#include "mpm/particles.hpp"
+
+namespace bfemp {
+
+template <int dim>
+struct ParticleSlabs {
+  int axis = 0;
+  int nranks = 1;
+  Kokkos::View<double*, MemSpace> cuts;  // nranks - 1 ascending cut coordinates
+
+  KOKKOS_INLINE_FUNCTION int owner(double coordinate) const {
+    int r = 0;
+    while (r < nranks - 1 && coordinate >= cuts(r)) ++r;
+    return r;
+  }
+};
+
+// Cuts for `nranks` slabs of about equal particle counts (every rank passes
+// the same `all`; no communication). One-off host work (setup, restart).
+template <int dim>
+ParticleSlabs<dim> balanced_slabs(const Particles<dim>& all, const GridSpec<dim>& grid, int nranks);
+
+// The particles of `all` in slab `rank`, and their indices in `all` (ids).
+template <int dim>
+Particles<dim> select_slab(const Particles<dim>& all, const ParticleSlabs<dim>& slabs, int rank,
+                           Kokkos::View<long long*, MemSpace>& ids);
+
+// Sends every particle outside this rank's slab to its owner and receives
+// those entering (collective). p and ids are replaced when anything moved
+// anywhere. Returns the number of particles that moved, summed over ranks.
+template <int dim>
+long long migrate_particles(Particles<dim>& p, Kokkos::View<long long*, MemSpace>& ids, const ParticleSlabs<dim>& slabs,
+                            const Teuchos::Comm<int>& comm);
+
+// All ranks' particles on rank `root`, placed by id (0..n_total-1); other
+// ranks get an empty set (collective).
+template <int dim>
+Particles<dim> gather_particles(const Particles<dim>& p, Kokkos::View<const long long*, MemSpace> ids,
+                                long long n_total, const Teuchos::Comm<int>& comm, int root = 0);
+
+}  // namespace bfemp
