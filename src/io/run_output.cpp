@@ -116,7 +116,8 @@ XdmfFrame RunOutput<dim>::xdmf_frame(const Simulation<dim>& sim, int index, doub
 }
 
 template <int dim>
-void RunOutput<dim>::write_frame(const Simulation<dim>& sim, const Particles<dim>* gathered) {
+void RunOutput<dim>::write_frame(const Simulation<dim>& sim, const Particles<dim>* gathered,
+                                 const std::vector<double>* gathered_forces) {
   const auto& mesh = sim.mesh();
   const std::size_t nn = mesh.num_nodes(), ne = mesh.num_cells();
   auto x = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), sim.positions());
@@ -150,7 +151,9 @@ void RunOutput<dim>::write_frame(const Simulation<dim>& sim, const Particles<dim
     h5_->write_array("particle_J", pJh.data(), np, 1);
     h5_->write_array("particle_body", body.data(), np, 1);
     const auto* contact = sim.contact();
-    if (contact && contact->particle_forces().extent(0) == np * dim) {
+    if (contact && gathered_forces && gathered_forces->size() == np * dim) {
+      h5_->write_array("particle_contact_force", gathered_forces->data(), np, dim);
+    } else if (contact && !gathered && contact->particle_forces().extent(0) == np * dim) {
       auto f = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), contact->particle_forces());
       h5_->write_array("particle_contact_force", f.data(), np, dim);
     } else if (contact) {

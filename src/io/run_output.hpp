@@ -40,7 +40,9 @@ class RunOutput {
             const OutputResume* resume = nullptr);
   // MPI runs of MPM bodies pass every rank's particles gathered in id order
   // (MpmBodies::gathered_particles); otherwise the simulation's are written.
-  void write_frame(const Simulation<dim>& sim, const Particles<dim>* gathered = nullptr);
+  // (with their contact forces, id order, when the scene has contact).
+  void write_frame(const Simulation<dim>& sim, const Particles<dim>* gathered = nullptr,
+                   const std::vector<double>* gathered_forces = nullptr);
   void write_diagnostics(const StepReport& r) { csv_->write_row(diagnostics_row(r)); }
   void close() { h5_->close(); }
   int frames_written() const { return frame_; }

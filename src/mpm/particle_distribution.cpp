@@ -235,6 +235,44 @@ Particles<dim> gather_particles(const Particles<dim>& p, Kokkos::View<const long
   return out;
 }
 
+std::vector<double> gather_particle_values(Kokkos::View<const double*, MemSpace> values, int k,
+                                           Kokkos::View<const long long*, MemSpace> ids, long long n_total,
+                                           const Teuchos::Comm<int>& comm, int root) {
+  const int me = comm.getRank(), n = comm.getSize();
+  const std::size_t np = ids.extent(0);
+  if (values.extent(0) < np * k) throw std::logic_error("gather_particle_values: fewer values than particles");
+  // Rows (id, k values) of this rank's particles.
+  Kokkos::View<double**, Kokkos::LayoutRight, MemSpace> buf("mpm_gather_values", np, k + 1);
+  Kokkos::parallel_for(
+      "mpm_pack_values", Kokkos::RangePolicy<ExecSpace>(0, np), KOKKOS_LAMBDA(const std::size_t q) {
+        buf(q, 0) = static_cast<double>(ids(q));
+        for (int j = 0; j < k; ++j) buf(q, 1 + j) = values(q * k + j);
+      });
+  auto hb = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), buf);
+  int mine = static_cast<int>(np) * (k + 1);
+  std::vector<int> counts(n, 0), disp(n, 0);
+  MPI_Comm c = raw(comm);
+  MPI_Gather(&mine, 1, MPI_INT, counts.data(), 1, MPI_INT, root, c);
+  long long total = 0;
+  for (int r = 0; r < n; ++r) {
+    disp[r] = static_cast<int>(total);
+    total += counts[r];
+  }
+  std::vector<double> recv(me == root ? static_cast<std::size_t>(total) : 0);
+  MPI_Gatherv(hb.data(), mine, MPI_DOUBLE, recv.data(), counts.data(), disp.data(), MPI_DOUBLE, root, c);
+  if (me != root) return {};
+  if (total != n_total * (k + 1))
+    throw std::logic_error("gather_particle_values: " + std::to_string(total / (k + 1)) + " particles, expected " +
+                           std::to_string(n_total));
+  std::vector<double> out(static_cast<std::size_t>(n_total) * k);
+  for (long long r = 0; r < n_total; ++r) {
+    const double* row = recv.data() + r * (k + 1);
+    const auto id = static_cast<std::size_t>(row[0]);
+    for (int j = 0; j < k; ++j) out[id * k + j] = row[1 + j];
+  }
+  return out;
+}
+
 #define BFEMP_INSTANTIATE(D)                                                                                        \
   template ParticleSlabs<D> balanced_slabs<D>(const Particles<D>&, const GridSpec<D>&, int);                        \
   template Particles<D> select_slab<D>(const Particles<D>&, const ParticleSlabs<D>&, int,                          \

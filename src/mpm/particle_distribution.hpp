@@ -62,4 +62,10 @@ template <int dim>
 Particles<dim> gather_particles(const Particles<dim>& p, Kokkos::View<const long long*, MemSpace> ids,
                                 long long n_total, const Teuchos::Comm<int>& comm, int root = 0);
 
+// A per-particle field (k values per particle, particle-major) of all ranks
+// on rank `root`, in id order (n_total k values; empty elsewhere; collective).
+std::vector<double> gather_particle_values(Kokkos::View<const double*, MemSpace> values, int k,
+                                           Kokkos::View<const long long*, MemSpace> ids, long long n_total,
+                                           const Teuchos::Comm<int>& comm, int root = 0);
+
 }  // namespace bfemp

@@ -244,7 +244,17 @@ RunSummary run_dim(const Scene& scene, const std::string& dir, const Teuchos::RC
   auto write_frame = [&] {  // collective, as the checkpoint
     if (sim.mpm() && sim.mpm()->distributed()) {
       const Particles<dim> all = sim.mpm()->gathered_particles();
-      if (root) out_ptr->write_frame(sim, &all);
+      std::vector<double> forces;
+      const auto* contact = sim.contact();
+      const auto* mpm = sim.mpm();
+      const auto fid = sim.contact_force_ids();
+      if (contact && fid.extent(0) > 0 && contact->particle_forces().extent(0) == fid.extent(0) * dim) {
+        forces = gather_particle_values(contact->particle_forces(), dim, fid, mpm->total_particles(), *comm);
+      } else if (contact) {  // before the first report (frame 0), on every rank alike: no force yet
+        Kokkos::View<double*, MemSpace> zero("frame_zero_forces", mpm->particles().size() * dim);
+        forces = gather_particle_values(zero, dim, mpm->particle_ids(), mpm->total_particles(), *comm);
+      }
+      if (root) out_ptr->write_frame(sim, &all, contact ? &forces : nullptr);
     } else if (root) {
       out_ptr->write_frame(sim);
     }

@@ -4,12 +4,44 @@
 
 #include <Kokkos_Timer.hpp>
 #include <Teuchos_CommHelpers.hpp>
+#include <functional>
 #include <iostream>
 #include <sstream>
 
 #include "solver/solver_error.hpp"
 
 namespace bfemp {
+
+namespace {
+// Runs check on every rank; when it throws std::invalid_argument on any,
+// every rank throws the message of the lowest rank that failed (rank 0
+// reports it).
+void collective_check(const Comm& comm, const std::function<void()>& check) {
+  std::string msg;
+  int failed = 0;
+  try {
+    check();
+  } catch (const std::invalid_argument& e) {
+    msg = e.what();
+    failed = 1;
+  }
+  if (comm.getSize() == 1) {
+    if (failed) throw std::invalid_argument(msg);
+    return;
+  }
+  const int mine = failed ? comm.getRank() : std::numeric_limits<int>::max();
+  int first = 0;
+  Teuchos::reduceAll(comm, Teuchos::REDUCE_MIN, mine, Teuchos::outArg(first));
+  if (first == std::numeric_limits<int>::max()) return;
+  int len = static_cast<int>(msg.size());
+  Teuchos::broadcast(comm, first, Teuchos::outArg(len));
+  std::string text(static_cast<std::size_t>(len), ' ');
+  if (comm.getRank() == first) text = msg;
+  if (len > 0) Teuchos::broadcast(comm, first, len, text.data());
+  throw std::invalid_argument(text);
+}
+
+}  // namespace
 
 using View1 = Kokkos::View<double*, MemSpace>;
 
@@ -50,18 +82,32 @@ Simulation<dim>::Simulation(SimulationSetup<dim> setup, const Teuchos::RCP<const
   }
   comm_ = comm;
   if (comm->getSize() > 1 && setup_.mpm) {
-    if (mesh_.num_nodes() > 0)
-      throw std::invalid_argument("this scene has MPM and FEM bodies; on several MPI ranks this version runs "
-                                  "scenes of MPM bodies alone or of FEM bodies alone (this run has " +
-                                  std::to_string(comm->getSize()) + " ranks): run it without mpirun or with -np 1");
+    if (setup_.contact && setup_.contact->fem_fem)
+      throw std::invalid_argument("Contact/FEM-FEM: true runs on 1 MPI rank in this version; this run has " +
+                                  std::to_string(comm->getSize()) + " ranks: run it without mpirun or with -np 1");
     for (const auto& ls : setup_.level_sets)
       if (ls.slip)
         throw std::invalid_argument("level set '" + ls.name + "': 'slip: true' runs on 1 MPI rank in this version "
                                     "(this run has " + std::to_string(comm->getSize()) +
                                     " ranks): run it without mpirun or with -np 1, or make it no-slip");
-    // Each rank keeps the particles of its slab; the grid is shared.
-    mpm_->distribute(comm, 0);
+    // Each rank keeps the particles of its slab; the grid is shared. FEM
+    // bodies: every rank holds the whole mesh and state (its nodes are local
+    // everywhere, with their global ids) and assembles the elements Zoltan2
+    // gives it; a node is owned by the lowest rank with an element on it.
+    mpm_->distribute(comm, mesh_.num_nodes());
     mpm_distributed_ = true;
+    if (mesh_.num_nodes() > 0) {
+      part_ = partition_fem_mesh<dim>(mesh_, comm);
+      FemPartition global_ids = part_;
+      global_ids.nodes.resize(mesh_.num_nodes());
+      for (LO v = 0; v < mesh_.num_nodes(); ++v) global_ids.nodes[v] = v;
+      local_elasticity_ =
+          std::make_unique<DeformationTerm<dim, dim + 1>>("fem elasticity", local_fem_mesh<dim>(mesh_, global_ids).elements);
+      if (!part_.elements.empty())
+        local_elasticity_->set_coloring(color_stencils<dim + 1>(local_elasticity_->stencils().nodes, mesh_.num_nodes()));
+      fem_owned_.assign(mesh_.num_nodes(), 0);
+      for (LO a = 0; a < part_.n_owned; ++a) fem_owned_[part_.nodes[a]] = 1;
+    }
     double m = mpm_min_particle_mass_;
     Teuchos::reduceAll(*comm, Teuchos::REDUCE_MIN, m, Teuchos::outArg(mpm_min_particle_mass_));
   }
@@ -139,13 +185,22 @@ Simulation<dim>::Simulation(SimulationSetup<dim> setup, const Teuchos::RCP<const
       throw std::invalid_argument("Contact/FEM-FEM: true runs on 1 MPI rank in this version; this run has " +
                                   std::to_string(comm->getSize()) + " ranks: run it without mpirun or with -np 1");
     contact_ = std::make_unique<Contact<dim>>(mesh_, *setup_.contact);
-    if (mpm_) contact_->check_initial(mpm_->particles(), x_);
+    // (MPI: each rank checks its particles; all stop with the first failing rank's message.)
+    if (mpm_) collective_check(*comm, [&] { contact_->check_initial(mpm_->particles(), x_); });
     else contact_->check_initial_fem(x_);
     if (setup_.contact->check_iterates)
       newton_->on_iterate = [this](Kokkos::View<const double*, MemSpace> x) {
         const LO q = contact_->particle_inside_at(x);
-        if (q < 0) return;
         const LO np = mpm_ ? static_cast<LO>(mpm_->particles().size()) : 0;
+        if (mpm_distributed_) {  // the highest global id inside, on every rank (no FEM points on several ranks)
+          long long mine = -1, id = -1;
+          if (q >= 0) Kokkos::deep_copy(mine, Kokkos::subview(mpm_->particle_ids(), q));
+          Teuchos::reduceAll(*comm_, Teuchos::REDUCE_MAX, mine, Teuchos::outArg(id));
+          if (id < 0) return;
+          throw SolverError("MPM particle " + std::to_string(id) +
+                            " is inside or on an FEM body at a Newton iterate (Contact/check iterates)");
+        }
+        if (q < 0) return;
         throw SolverError((q < np ? "MPM particle " + std::to_string(q)
                                   : "FEM boundary node (contact point " + std::to_string(q - np) + ")") +
                           " is inside or on an FEM body at a Newton iterate (Contact/check iterates)");
@@ -252,6 +307,28 @@ void hold_massless_grid_nodes(std::size_t first, std::size_t n, View1 x, View1 v
 }
 }  // namespace
 
+// MPI: the contact report of every rank's pairs.
+template <int dim>
+void Simulation<dim>::reduce_report(typename Contact<dim>::Report& r) const {
+  const Comm& c = *comm_;
+  const long long pairs = r.pairs;
+  long long all_pairs = 0;
+  Teuchos::reduceAll(c, Teuchos::REDUCE_SUM, pairs, Teuchos::outArg(all_pairs));
+  r.pairs = static_cast<LO>(all_pairs);
+  double sums[4] = {r.barrier_energy, r.force[0], r.force[1], r.force[2]}, s[4];
+  Teuchos::reduceAll(c, Teuchos::REDUCE_SUM, 4, sums, s);
+  r.barrier_energy = s[0];
+  r.force = {s[1], s[2], s[3]};
+  double mins[5] = {r.min_distance, r.ccd_alpha_min, r.extent_lo[0], r.extent_lo[1], r.extent_lo[2]}, mn[5];
+  Teuchos::reduceAll(c, Teuchos::REDUCE_MIN, 5, mins, mn);
+  r.min_distance = mn[0];
+  r.ccd_alpha_min = mn[1];
+  r.extent_lo = {mn[2], mn[3], mn[4]};
+  double maxs[3] = {r.extent_hi[0], r.extent_hi[1], r.extent_hi[2]}, mx[3];
+  Teuchos::reduceAll(c, Teuchos::REDUCE_MAX, 3, maxs, mx);
+  r.extent_hi = {mx[0], mx[1], mx[2]};
+}
+
 template <int dim>
 StepReport Simulation<dim>::step() {
   Kokkos::Timer timer;
@@ -284,7 +361,7 @@ StepReport Simulation<dim>::step() {
   Kokkos::deep_copy(Kokkos::subview(pres, fem), prescribed_);
   std::vector<const EnergyTerm<dim>*> terms;
   bool graph_rebuilt = false;
-  if (nF > 0) terms.push_back(elasticity_.get());
+  if (nF > 0) terms.push_back(mpm_distributed_ ? local_elasticity_.get() : elasticity_.get());
   if (mpm_) {
     auto grid_part = std::make_pair(nfd, nd);
     Kokkos::deep_copy(Kokkos::subview(pres, grid_part), 0);
@@ -298,7 +375,15 @@ StepReport Simulation<dim>::step() {
       terms.push_back(contact_->barrier());
       if (contact_->has_friction()) terms.push_back(contact_->friction());
     }
-    if (mpm_distributed_) newton_->set_partition(mpm_->global_nodes(), mpm_->owned_nodes());
+    if (mpm_distributed_) {  // FEM nodes (global ids 0..nF-1) then this rank's grid nodes
+      std::vector<GO> ids(static_cast<std::size_t>(nF));
+      for (LO v = 0; v < nF; ++v) ids[v] = v;
+      ids.insert(ids.end(), mpm_->global_nodes().begin(), mpm_->global_nodes().end());
+      std::vector<char> owned = fem_owned_;
+      owned.resize(ids.size(), 0);
+      for (LO k = 0; k < mpm_->owned_nodes(); ++k) owned[nF + k] = 1;
+      newton_->set_partition(std::move(ids), owned);
+    }
     graph_rebuilt = newton_->set_system(nF + nA, terms);
     // Grid a^n = g - M^-1 grad Psi(x^n): the Newmark predictor and velocity
     // update need it; backward Euler (no a^n term in either) does not.
@@ -397,6 +482,14 @@ StepReport Simulation<dim>::step() {
   if (graph_rebuilt) ++ns.graph_builds;
   typename Contact<dim>::Report contact_report;
   if (contact_) contact_report = contact_->report(x, nF);
+  if (contact_ && mpm_distributed_) {
+    reduce_report(contact_report);
+    // The particle contact forces follow this step's particle order, which
+    // migration below changes: keep their ids for the output.
+    const auto ids = mpm_->particle_ids();
+    if (force_ids_.extent(0) != ids.extent(0)) force_ids_ = Kokkos::View<long long*, MemSpace>("contact_force_ids", ids.extent(0));
+    Kokkos::deep_copy(force_ids_, ids);
+  }
 
   const double gamma = ti.gamma;
   Kokkos::parallel_for(
@@ -497,11 +590,14 @@ void Simulation<dim>::count_penetrations(StepReport& r) {
         }
       },
       ls_count, Kokkos::Max<double>(depth));
-  if (mpm_distributed_) {  // every rank's particles (no FEM bodies on several ranks)
-    const long n = ls_count;
+  if (mpm_distributed_) {  // every rank's particles
+    const long n[2] = {ls_count, fem_count};
+    long sum[2] = {0, 0};
     const double d = depth;
-    Teuchos::reduceAll(*comm_, Teuchos::REDUCE_SUM, n, Teuchos::outArg(ls_count));
+    Teuchos::reduceAll(*comm_, Teuchos::REDUCE_SUM, 2, n, sum);
     Teuchos::reduceAll(*comm_, Teuchos::REDUCE_MAX, d, Teuchos::outArg(depth));
+    ls_count = sum[0];
+    fem_count = sum[1];
   }
   r.penetrations = fem_count + ls_count;
   r.penetration_depth = ls_count > 0 ? depth : 0.0;  // (the Max reducer starts at -DBL_MAX)
@@ -515,7 +611,15 @@ NewtonStats Simulation<dim>::minimize_with_friction(const IncrementalPotential& 
                                                     int& iterations) {
   NewtonStats total;
   const int cap = contact_->friction_max_iterations();
-  LO lagged = contact_->update_friction(x, x_ref, s, ip.dt);  // line 5: lagged at x^n
+  auto update = [&] {  // pairs with friction, over all ranks
+    LO n = contact_->update_friction(x, x_ref, s, ip.dt);
+    if (mpm_distributed_) {
+      const LO mine = n;
+      Teuchos::reduceAll(*comm_, Teuchos::REDUCE_SUM, mine, Teuchos::outArg(n));
+    }
+    return n;
+  };
+  LO lagged = update();  // line 5: lagged at x^n
   for (iterations = 1;; ++iterations) {
     const NewtonStats st = newton_->minimize(ip, x);
     total.iterations += st.iterations;
@@ -530,11 +634,11 @@ NewtonStats Simulation<dim>::minimize_with_friction(const IncrementalPotential& 
     total.exact_hessian_iterations += st.exact_hessian_iterations;
     total.projection_fallbacks += st.projection_fallbacks;
     if (iterations > 1 && st.iterations == 1) break;  // converged at the lagged update
-    const LO relagged = contact_->update_friction(x, x_ref, s, ip.dt);
+    const LO relagged = update();
     if (lagged == 0 && relagged == 0) break;  // no friction pairs before or after
     lagged = relagged;
     if (iterations == cap) {
-      std::cerr << "warning: step " << step_ + 1 << ": friction not converged in " << cap
+      if (comm_->getRank() == 0) std::cerr << "warning: step " << step_ + 1 << ": friction not converged in " << cap
                 << " outer iterations ('Contact/friction iterations')\n";
       break;
     }

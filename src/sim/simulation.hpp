@@ -122,6 +122,9 @@ class Simulation {
   const MpmBodies<dim>* mpm() const { return mpm_.get(); }
   NewtonSolver<dim>& newton() { return *newton_; }
   const Contact<dim>* contact() const { return contact_.get(); }
+  // MPI (MPM distributed): the global particle id of each entry of
+  // contact()->particle_forces() (the step's particle order, before migration).
+  Kokkos::View<const long long*, MemSpace> contact_force_ids() const { return force_ids_; }
   // The energy terms this scene built (names, in assembly order): only what
   // it needs (no MPM, contact or friction term unless the scene has them).
   std::vector<std::string> term_names() const;
@@ -141,6 +144,7 @@ class Simulation {
   void apply_prescribed_targets(double t, Kokkos::View<double*, MemSpace> target) const;
   void prescribed_velocities(double t1);
   void count_penetrations(StepReport& r);
+  void reduce_report(typename Contact<dim>::Report& r) const;
   // MPI: Newton on this rank's nodes, the result summed into every rank's x.
   NewtonStats minimize_distributed(const IncrementalPotential& ip, Kokkos::View<double*, MemSpace> x,
                                    Kokkos::View<double*, MemSpace> work);
@@ -168,7 +172,9 @@ class Simulation {
   bool distributed_ = false;      // FEM bodies only, elements cut into the ranks
   bool mpm_distributed_ = false;  // MPM bodies only, particles cut into slabs (MpmBodies::distribute)
   FemPartition part_;
-  std::unique_ptr<DeformationTerm<dim, dim + 1>> local_elasticity_;
+  std::unique_ptr<DeformationTerm<dim, dim + 1>> local_elasticity_;  // MPM + FEM: this rank's elements, global node ids
+  std::vector<char> fem_owned_;
+  Kokkos::View<long long*, MemSpace> force_ids_;  // contact_force_ids()  // MPM + FEM on several ranks: FEM nodes owned here
   Kokkos::View<LO*, MemSpace> local_dof_;
   Kokkos::View<double*, MemSpace> lx_, lxhat_, lmass_, ltarget_;
   Kokkos::View<int*, MemSpace> lpres_;

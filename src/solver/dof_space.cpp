@@ -6,6 +6,7 @@
 #include <Tpetra_Export.hpp>
 #include <Tpetra_Import.hpp>
 #include <Tpetra_Vector.hpp>
+#include <algorithm>
 #include <stdexcept>
 
 #include "solver/dof_graph.hpp"
@@ -22,8 +23,18 @@ template <int dim>
 void DofSpace<dim>::set_partition(std::vector<GO> global_nodes, LO n_owned) {
   if (n_owned < 0 || n_owned > static_cast<LO>(global_nodes.size()))
     throw std::invalid_argument("DofSpace::set_partition: n_owned outside [0, local nodes]");
+  std::vector<char> owned(global_nodes.size(), 0);
+  for (LO a = 0; a < n_owned; ++a) owned[a] = 1;
+  set_partition(std::move(global_nodes), owned);
+}
+
+template <int dim>
+void DofSpace<dim>::set_partition(std::vector<GO> global_nodes, const std::vector<char>& owned) {
+  if (owned.size() != global_nodes.size())
+    throw std::invalid_argument("DofSpace::set_partition: an owned flag per local node expected");
   global_nodes_ = std::move(global_nodes);
-  n_owned_ = n_owned;
+  owned_nodes_ = owned;
+  n_owned_ = static_cast<LO>(std::count_if(owned.begin(), owned.end(), [](char c) { return c != 0; }));
   maps_stale_ = true;
 }
 
@@ -31,12 +42,23 @@ template <int dim>
 void DofSpace<dim>::build_maps() {
   using gsize = Tpetra::global_size_t;
   const gsize invalid = Teuchos::OrdinalTraits<gsize>::invalid();
-  std::vector<GO> owned(static_cast<std::size_t>(n_owned_) * dim), all(global_nodes_.size() * dim);
+  std::vector<GO> owned, all(global_nodes_.size() * dim);
+  owned.reserve(static_cast<std::size_t>(n_owned_) * dim);
+  const std::size_t nl = global_nodes_.size() * dim;
+  owned_mask_ = Kokkos::View<int*, MemSpace>("dof_owned_mask", nl);
+  owned_dofs_ = Kokkos::View<LO*, MemSpace>("dof_owned_dofs", static_cast<std::size_t>(n_owned_) * dim);
+  auto mask = Kokkos::create_mirror_view(owned_mask_);
+  auto od = Kokkos::create_mirror_view(owned_dofs_);
   for (std::size_t a = 0; a < global_nodes_.size(); ++a)
     for (int c = 0; c < dim; ++c) {
       all[a * dim + c] = global_nodes_[a] * dim + c;
-      if (a < static_cast<std::size_t>(n_owned_)) owned[a * dim + c] = global_nodes_[a] * dim + c;
+      mask(a * dim + c) = owned_nodes_[a] ? 1 : 0;
+      if (!owned_nodes_[a]) continue;
+      od(owned.size()) = static_cast<LO>(a * dim + c);
+      owned.push_back(global_nodes_[a] * dim + c);
     }
+  Kokkos::deep_copy(owned_mask_, mask);
+  Kokkos::deep_copy(owned_dofs_, od);
   map_ = Teuchos::rcp(new Map(invalid, Teuchos::ArrayView<const GO>(owned), 0, comm_));
   overlap_map_ = Teuchos::rcp(new Map(invalid, Teuchos::ArrayView<const GO>(all), 0, comm_));
   export_ = Teuchos::rcp(new Tpetra::Export<LO, GO, Node>(overlap_map_, map_));
@@ -173,17 +195,19 @@ void DofSpace<dim>::end_assembly(MaskView prescribed, ConstDofView dx_prescribed
   A_->resumeFill();
   A_->setAllToScalar(0.0);
   A_->doExport(*A_overlap_, *export_, Tpetra::ADD);
-  // Constraint rows on the owned side (owned local DOFs come first locally).
+  // Constraint rows on the owned side (owned row r is local DOF owned_dofs(r)).
   auto lcl = A_->getLocalMatrixDevice();
   auto bv = Kokkos::subview(b.getLocalViewDevice(Tpetra::Access::ReadWrite), Kokkos::ALL(), 0);
   const auto dcol = diag_col_;
+  const auto od = owned_dofs_;
   Kokkos::parallel_for(
-      "dof_space_prescribed_rows_owned", Kokkos::RangePolicy<ExecSpace>(0, num_owned_dofs()), KOKKOS_LAMBDA(const LO i) {
+      "dof_space_prescribed_rows_owned", Kokkos::RangePolicy<ExecSpace>(0, num_owned_dofs()), KOKKOS_LAMBDA(const LO r) {
+        const LO i = od(r);
         if (!prescribed(i)) return;
         const double one = 1.0;
-        const LO c = dcol(i);
-        lcl.replaceValues(i, &c, 1, &one, false, false);
-        bv(i) = dx_prescribed(i);
+        const LO c = dcol(r);
+        lcl.replaceValues(r, &c, 1, &one, false, false);
+        bv(r) = dx_prescribed(i);
       });
   A_->fillComplete(map_, map_, fill_params_);
 }

@@ -21,7 +21,9 @@
 // local DOF ids, so the sink is the same) and one Export with ADD moves the
 // sums into the owned matrix and right-hand side the linear solver sees; the
 // solution comes back to the ghosts with one Import. Constraint rows are
-// written once, on the owned side. Slip constraints: 1 rank only (for now).
+// written once, on the owned side. The owned nodes may come first (n_owned)
+// or lie anywhere among the local ones (a mask: MPM grid nodes beside a
+// replicated FEM mesh). Slip constraints: 1 rank only (for now).
 #include <Teuchos_ParameterList.hpp>
 #include <Tpetra_Export_decl.hpp>
 #include <Tpetra_Import_decl.hpp>
@@ -44,7 +46,14 @@ class DofSpace {
   // node is owned by exactly one rank. Takes effect at the next
   // set_structure (whose n_nodes must be global_nodes.size()).
   void set_partition(std::vector<GO> global_nodes, LO n_owned);
+  // The same with the owned nodes anywhere among the local ones (owned[a] !=
+  // 0: local node a is owned here). The owned map lists them in local order.
+  void set_partition(std::vector<GO> global_nodes, const std::vector<char>& owned);
   bool distributed() const { return n_owned_ >= 0; }
+  // Distributed: 1 at the local DOFs this rank owns, and the local DOF of
+  // each owned-map row (after set_structure).
+  Kokkos::View<const int*, MemSpace> owned_mask() const { return owned_mask_; }
+  Kokkos::View<const LO*, MemSpace> owned_dofs() const { return owned_dofs_; }
   // Owned nodes and DOFs of this rank (all nodes without a partition).
   LO num_owned_nodes() const { return n_owned_ >= 0 ? n_owned_ : n_nodes_; }
   std::size_t num_owned_dofs() const { return static_cast<std::size_t>(num_owned_nodes() < 0 ? 0 : num_owned_nodes()) * dim; }
@@ -102,7 +111,10 @@ class DofSpace {
   Teuchos::RCP<Teuchos::ParameterList> fill_params_;
   LO n_nodes_ = -1;
   std::vector<GO> global_nodes_;  // distributed: global id of each local node
-  LO n_owned_ = -1;               // distributed: owned nodes (the first ones)
+  std::vector<char> owned_nodes_; // distributed: owned flag of each local node
+  LO n_owned_ = -1;               // distributed: owned nodes
+  Kokkos::View<int*, MemSpace> owned_mask_;  // per local DOF
+  Kokkos::View<LO*, MemSpace> owned_dofs_;   // per owned-map row: its local DOF
   bool maps_stale_ = false;
   Teuchos::RCP<const Map> map_, overlap_map_;
   Teuchos::RCP<Matrix> A_, A_overlap_;  // A_overlap_: the terms' sink (distributed)

@@ -141,7 +141,8 @@ void rigid_body_modes(Kokkos::View<const double*, MemSpace> x, MultiVec& modes) 
   constexpr int nm = dim == 2 ? 3 : 6;
   if (static_cast<int>(modes.getNumVectors()) != nm)
     throw std::logic_error("rigid_body_modes: wrong column count");
-  // The modes' map holds this rank's owned nodes, which come first in x.
+  // The modes' map holds this rank's owned nodes, the first ones of x (the
+  // caller passes them so).
   const LO n_nodes = static_cast<LO>(modes.getLocalLength() / dim);
   if (static_cast<std::size_t>(n_nodes) * dim > x.extent(0))
     throw std::logic_error("rigid_body_modes: fewer positions than the modes' rows");

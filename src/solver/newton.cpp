@@ -74,7 +74,15 @@ struct NewtonSolver<dim>::Impl {
     solves_since_modes = 0;
     constexpr int nm = dim == 2 ? 3 : 6;
     if (modes.is_null() || modes->getMap() != dofs.map()) modes = Teuchos::rcp(new MultiVec(dofs.map(), nm));
-    rigid_body_modes<dim>(x, *modes);
+    if (dofs.distributed()) {  // the owned rows' positions, in the owned map's order
+      const auto od = dofs.owned_dofs();
+      View1 xo("newton_owned_x", od.extent(0));
+      Kokkos::parallel_for(
+          "newton_owned_x", Kokkos::RangePolicy<ExecSpace>(0, od.extent(0)), KOKKOS_LAMBDA(const LO r) { xo(r) = x(od(r)); });
+      rigid_body_modes<dim>(xo, *modes);
+    } else {
+      rigid_body_modes<dim>(x, *modes);
+    }
     solver.set_near_null_space(modes, dim);
   }
 
@@ -99,10 +107,11 @@ struct NewtonSolver<dim>::Impl {
     auto mass = ip.mass;
     auto xhat = ip.x_hat;
     auto pres = ip.prescribed;
-    const LO n_own = static_cast<LO>(dofs.num_owned_dofs());  // inertia once, at the owner
+    const bool dist = dofs.distributed();  // inertia once, at the owner
+    const auto own = dofs.owned_mask();
     Kokkos::parallel_for(
         "newton_inertia", Kokkos::RangePolicy<ExecSpace>(0, g.extent(0)), KOKKOS_LAMBDA(const LO i) {
-          const bool owned = i < n_own;
+          const bool owned = !dist || own(i);
           if (owned) g(i) += mass(i) * (x(i) - xhat(i));
           if (pres(i)) return;  // the DOF space writes the constraint row
           r(i) -= g(i);
@@ -125,6 +134,11 @@ NewtonSolver<dim>::~NewtonSolver() = default;
 template <int dim>
 void NewtonSolver<dim>::set_partition(std::vector<GO> global_nodes, LO n_owned) {
   impl_->dofs.set_partition(std::move(global_nodes), n_owned);
+}
+
+template <int dim>
+void NewtonSolver<dim>::set_partition(std::vector<GO> global_nodes, const std::vector<char>& owned) {
+  impl_->dofs.set_partition(std::move(global_nodes), owned);
 }
 
 template <int dim>
@@ -207,9 +221,12 @@ typename NewtonSolver<dim>::Energy NewtonSolver<dim>::energy(const IncrementalPo
   Energy E;
   auto mass = ip.mass;
   auto xhat = ip.x_hat;
+  const bool dist = impl_->dofs.distributed();  // each DOF once, at its owner
+  const auto own = impl_->dofs.owned_mask();
   Kokkos::parallel_reduce(
-      "newton_inertia_energy", Kokkos::RangePolicy<ExecSpace>(0, impl_->dofs.num_owned_dofs()),
+      "newton_inertia_energy", Kokkos::RangePolicy<ExecSpace>(0, impl_->dofs.num_dofs()),
       KOKKOS_LAMBDA(const LO i, double& acc) {
+        if (dist && !own(i)) return;
         const double d = x(i) - xhat(i);
         acc += 0.5 * mass(i) * d * d;
       },
@@ -384,9 +401,14 @@ NewtonStats NewtonSolver<dim>::minimize(const IncrementalPotential& ip, View1 x)
         // The local gradient holds this rank's part only; the owned rhs is the
         // summed -grad at free rows.
         auto bv = Kokkos::subview(m.b->getLocalViewDevice(Tpetra::Access::ReadOnly), Kokkos::ALL(), 0);
+        const auto od = m.dofs.owned_dofs();
         Kokkos::parallel_reduce(
             "newton_grad_dot_p_owned", Kokkos::RangePolicy<ExecSpace>(0, m.dofs.num_owned_dofs()),
-            KOKKOS_LAMBDA(const LO i, double& acc) { acc -= pres(i) ? 0.0 : bv(i) * dir(i); }, gp);
+            KOKKOS_LAMBDA(const LO r, double& acc) {
+              const LO i = od(r);
+              acc -= pres(i) ? 0.0 : bv(r) * dir(i);
+            },
+            gp);
         gp = m.all_sum(gp);
       }
       while (true) {

@@ -84,6 +84,7 @@ class NewtonSolver {
   // rank's stencils (each stencil on one rank), and ip.mass is the global
   // lumped mass at every local DOF. Without it the solver runs on 1 rank.
   void set_partition(std::vector<GO> global_nodes, LO n_owned);
+  void set_partition(std::vector<GO> global_nodes, const std::vector<char>& owned);
 
   // Declares the unknowns (n_nodes * dim DOFs) and the terms of Psi. The DOF
   // space rebuilds the graph (and the linear solver its symbolic phase) only

@@ -1,11 +1,13 @@
 #!/usr/bin/env bash
 # The bfemp executable on 1 and 2 MPI ranks (label mpi): the squash scene
 # (FEM only, CG) gives the same frames and diagnostics on both; on 2 ranks a
-# direct solver, a scene of MPM and FEM bodies and an explicit scene are refused before the
+# direct solver, FEM-FEM contact and an explicit scene are refused before the
 # first step (exit 2, a message naming the key); a 2-rank run restarted on 2 ranks equals the
 # uninterrupted one bit for bit. The MPM column (MPM alone: particles in slabs) gives the same
 # frames on 1 and 2 ranks (particles gathered in scene order), and its 2-rank restart equals
-# the uninterrupted run to solver tolerance (the restart re-cuts the slabs). Usage: run_np2.sh BFEMP SOURCE_DIR WORK_DIR
+# the uninterrupted run to solver tolerance (the restart re-cuts the slabs). The colliding
+# rings (MPM + FEM, barrier contact) write the same frames on 1 and 2 ranks, the particles'
+# contact forces included (gathered in scene order). Usage: run_np2.sh BFEMP SOURCE_DIR WORK_DIR
 set -euo pipefail
 exe=$1; src=$2; work=$3
 rm -rf "$work"; mkdir -p "$work"
@@ -71,15 +73,15 @@ set -e
 [ $rc = 2 ] && grep -q "Linear Solver/type" "$work/direct.log" || { echo "direct solver on 2 ranks: exit $rc"; cat "$work/direct.log"; exit 1; }
 [ ! -e "$work/direct/bfemp.h5" ] || { echo "the refused run wrote output"; exit 1; }
 set +e
-"${mpi[@]}" -np 2 "$exe" run "$src/inputs/contact_rings.yaml" --output "$work/mpm_fem" --set 'Linear Solver/type=CG' > "$work/mpm_fem.log" 2>&1; rc=$?
+"${mpi[@]}" -np 2 "$exe" run "$src/inputs/a6_semiring_buckling.yaml" --output "$work/fem_fem" --set 'Linear Solver/type=CG' > "$work/fem_fem.log" 2>&1; rc=$?
 set -e
-[ $rc = 2 ] && grep -q "MPM and FEM bodies" "$work/mpm_fem.log" || { echo "MPM + FEM scene on 2 ranks: exit $rc"; cat "$work/mpm_fem.log"; exit 1; }
+[ $rc = 2 ] && grep -q "Contact/FEM-FEM" "$work/fem_fem.log" || { echo "FEM-FEM contact on 2 ranks: exit $rc"; cat "$work/fem_fem.log"; exit 1; }
 set +e
 "${mpi[@]}" -np 2 "$exe" run "$src/inputs/b1_contact.yaml" --output "$work/explicit" > "$work/explicit.log" 2>&1; rc=$?
 set -e
 [ $rc = 2 ] && grep -q "'Solver' = 'explicit'" "$work/explicit.log" || { echo "explicit scene on 2 ranks: exit $rc"; cat "$work/explicit.log"; exit 1; }
 [ ! -e "$work/explicit/bfemp.h5" ] || { echo "the refused explicit run wrote output"; exit 1; }
-echo "refusals on 2 ranks: direct solver, MPM + FEM scene, explicit scene (exit 2)"
+echo "refusals on 2 ranks: direct solver, FEM-FEM contact, explicit scene (exit 2)"
 # MPM bodies alone on 2 ranks.
 mcg=(--set 'Linear Solver/type=CG' --set 'Time/end time=0.2')
 "${mpi[@]}" -np 1 "$exe" run "$src/inputs/mpm_column.yaml" --output "$work/mpm1" "${mcg[@]}" > "$work/mpm1.log" 2>&1
@@ -115,4 +117,23 @@ for other in (b, c):
             assert abs(u - v) <= 1e-7 * max(abs(u), 1e-9), (other, x["step"], k, u, v)
         assert x["active_grid_nodes"] == y["active_grid_nodes"], (other, x["step"])
 print("MPM column: 1 rank, 2 ranks and a 2-rank restart agree (3 frames, 10 diagnostics rows)")
+PY
+# MPM and FEM bodies in contact on 2 ranks.
+rcg=(--set 'Linear Solver/type=CG' --set 'Linear Solver/CG/tolerance=1e-13' --set 'Newton/eps_d=1e-9' --set 'Time/end time=0.03')
+"${mpi[@]}" -np 1 "$exe" run "$src/inputs/contact_rings.yaml" --output "$work/rings1" "${rcg[@]}" > "$work/rings1.log" 2>&1
+"${mpi[@]}" -np 2 "$exe" run "$src/inputs/contact_rings.yaml" --output "$work/rings2" "${rcg[@]}" > "$work/rings2.log" 2>&1
+/usr/bin/python3 - "$work/rings1" "$work/rings2" <<'PY'
+import sys, h5py, numpy as np
+a, b = sys.argv[1:3]
+with h5py.File(a + "/bfemp.h5", "r") as fa, h5py.File(b + "/bfemp.h5", "r") as fb:
+    fr = sorted(k for k in fa if k.startswith("frame_"))
+    assert fr == sorted(k for k in fb if k.startswith("frame_")) and len(fr) == 4, fr
+    f = fr[-1]
+    force = fa[f]["particle_contact_force"][()]
+    assert np.abs(force).max() > 0, "no contact force in the last frame: the check checks nothing"
+    for d in ("positions", "particle_positions", "particle_contact_force", "particle_velocities"):
+        va, vb = fa[f][d][()], fb[f][d][()]
+        err = np.abs(va - vb).max() / np.abs(va).max()
+        assert err < 1e-8, f"{f}/{d}: relative difference {err}"
+print("rings (MPM + FEM contact): 1 and 2 ranks write the same frames, contact forces included")
 PY
