@@ -5,8 +5,8 @@
 // block with gravity, in 2D and 3D, with CG + Ifpack2 and CG + MueLu; and
 // every rank reports the same Newton iterations. A one-triangle body, so that
 // on 2 ranks one rank owns no element at all, equals the same on one rank.
-// Scenes of MPM and FEM bodies together are refused on more than one rank
-// (MPM bodies alone: test_mpm_mpi).
+// Slip level sets are refused on more than one rank (MPM bodies, with or
+// without FEM bodies: test_mpm_mpi).
 #include <gtest/gtest.h>
 
 #include <Teuchos_CommHelpers.hpp>
@@ -141,16 +141,19 @@ TEST(SimulationMpi, ARankWithoutElementsEqualsOneRank) {
   expect_same_on_every_rank(*world, d.iterations);
 }
 
-TEST(SimulationMpi, MpmWithFemSceneRefusedOnSeveralRanks) {
+TEST(SimulationMpi, SlipLevelSetRefusedOnSeveralRanks) {
   auto world = Tpetra::getDefaultComm();
   if (world->getSize() == 1) GTEST_SKIP() << "needs 2 ranks";
   auto setup = fixtures::mpm_block_setup(0.4, Vec<2>(0.5, 0.5), 0.1, 4, 0.0, 1.0, TransferScheme::APIC);
-  setup.bodies = fixtures::block_setup<2>(0.2, 1e5, 0.3, 1000.0, 1.0, "CG").bodies;
   setup.linear_solver.set("type", std::string("CG"));
+  LevelSet floor;
+  floor.name = "floor";
+  floor.slip = true;
+  setup.level_sets.push_back(floor);
   try {
     Simulation<2> sim(setup, world);
-    FAIL() << "a scene of MPM and FEM bodies was accepted on " << world->getSize() << " ranks";
+    FAIL() << "a slip level set was accepted on " << world->getSize() << " ranks";
   } catch (const std::invalid_argument& e) {
-    EXPECT_NE(std::string(e.what()).find("MPM and FEM bodies"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("level set 'floor'"), std::string::npos) << e.what();
   }
 }
