@@ -147,7 +147,8 @@ LO Contact<dim>::particle_inside_at(ConstDofView x) const {
 }
 
 template <int dim>
-void Contact<dim>::check_initial(const Particles<dim>& p, ConstDofView x_fem) const {
+void Contact<dim>::check_initial(const Particles<dim>& p, ConstDofView x_fem,
+                                 Kokkos::View<const long long*, MemSpace> ids) const {
   const LO np = static_cast<LO>(p.size());
   Kokkos::View<double*, MemSpace> xp("contact_check_xp", static_cast<std::size_t>(np) * dim);
   interleaved_positions(p, xp);
@@ -155,7 +156,9 @@ void Contact<dim>::check_initial(const Particles<dim>& p, ConstDofView x_fem) co
   if (bad >= 0) {
     auto h = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), p.x);
     std::ostringstream msg;
-    msg << "MPM particle " << bad << " at (";
+    long long id = bad;
+    if (ids.extent(0) > static_cast<std::size_t>(bad)) Kokkos::deep_copy(id, Kokkos::subview(ids, bad));
+    msg << "MPM particle " << id << " at (";
     for (int c = 0; c < dim; ++c) msg << (c ? ", " : "") << h(bad, c);
     msg << ") starts inside or on an FEM body: the MPM and FEM bodies must not intersect or touch at t = 0 "
            "(paper Eq. 15); move the bodies apart";
@@ -201,6 +204,9 @@ void Contact<dim>::begin_step(const MpmBodies<dim>* mpm, ConstDofView x) {
     ps_.body = nfp > 0 || !mpm ? Kokkos::View<int*, MemSpace>("contact_point_body", n) : mpm->particles().body;
     ps_.fem_body_base = nfp > 0 ? params_.mpm_bodies : INT_MAX;
   }
+  // The particles' own body View: new after a restart or an MPI migration
+  // (which may keep the count), so taken every step.
+  if (mpm && nfp == 0) ps_.body = mpm->particles().body;
   const auto ps = ps_;
   if (mpm) {
     const auto& p = mpm->particles();

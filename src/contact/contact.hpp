@@ -42,7 +42,9 @@ class Contact {
   // Throws std::invalid_argument naming the particle when one starts inside
   // an FEM element or at distance <= 0 from the FEM boundary (x: FEM nodes).
   // With FEM-FEM contact it also runs check_initial_fem.
-  void check_initial(const Particles<dim>& p, ConstDofView x_fem) const;
+  // ids: the particles' scene indices for the message (MPI; empty: p's own).
+  void check_initial(const Particles<dim>& p, ConstDofView x_fem,
+                     Kokkos::View<const long long*, MemSpace> ids = {}) const;
   // FEM-FEM contact: throws naming the FEM node and its body when a boundary
   // node starts inside or on another FEM body.
   void check_initial_fem(ConstDofView x_fem) const;

@@ -247,9 +247,10 @@ RunSummary run_dim(const Scene& scene, const std::string& dir, const Teuchos::RC
       std::vector<double> forces;
       const auto* contact = sim.contact();
       const auto* mpm = sim.mpm();
-      const auto fid = sim.contact_force_ids();
-      if (contact && fid.extent(0) > 0 && contact->particle_forces().extent(0) == fid.extent(0) * dim) {
-        forces = gather_particle_values(contact->particle_forces(), dim, fid, mpm->total_particles(), *comm);
+      // (The branch is the same on every rank: contact_reported() is.)
+      if (contact && sim.contact_reported()) {
+        forces = gather_particle_values(contact->particle_forces(), dim, sim.contact_force_ids(), mpm->total_particles(),
+                                        *comm);
       } else if (contact) {  // before the first report (frame 0), on every rank alike: no force yet
         Kokkos::View<double*, MemSpace> zero("frame_zero_forces", mpm->particles().size() * dim);
         forces = gather_particle_values(zero, dim, mpm->particle_ids(), mpm->total_particles(), *comm);

@@ -186,7 +186,7 @@ Simulation<dim>::Simulation(SimulationSetup<dim> setup, const Teuchos::RCP<const
                                   std::to_string(comm->getSize()) + " ranks: run it without mpirun or with -np 1");
     contact_ = std::make_unique<Contact<dim>>(mesh_, *setup_.contact);
     // (MPI: each rank checks its particles; all stop with the first failing rank's message.)
-    if (mpm_) collective_check(*comm, [&] { contact_->check_initial(mpm_->particles(), x_); });
+    if (mpm_) collective_check(*comm, [&] { contact_->check_initial(mpm_->particles(), x_, mpm_->particle_ids()); });
     else contact_->check_initial_fem(x_);
     if (setup_.contact->check_iterates)
       newton_->on_iterate = [this](Kokkos::View<const double*, MemSpace> x) {
@@ -489,6 +489,7 @@ StepReport Simulation<dim>::step() {
     const auto ids = mpm_->particle_ids();
     if (force_ids_.extent(0) != ids.extent(0)) force_ids_ = Kokkos::View<long long*, MemSpace>("contact_force_ids", ids.extent(0));
     Kokkos::deep_copy(force_ids_, ids);
+    contact_reported_ = true;  // on every rank, with or without particles
   }
 
   const double gamma = ti.gamma;

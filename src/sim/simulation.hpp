@@ -124,7 +124,9 @@ class Simulation {
   const Contact<dim>* contact() const { return contact_.get(); }
   // MPI (MPM distributed): the global particle id of each entry of
   // contact()->particle_forces() (the step's particle order, before migration).
+  // contact_reported(): a step has reported contact forces (the same on every rank).
   Kokkos::View<const long long*, MemSpace> contact_force_ids() const { return force_ids_; }
+  bool contact_reported() const { return contact_reported_; }
   // The energy terms this scene built (names, in assembly order): only what
   // it needs (no MPM, contact or friction term unless the scene has them).
   std::vector<std::string> term_names() const;
@@ -173,8 +175,9 @@ class Simulation {
   bool mpm_distributed_ = false;  // MPM bodies only, particles cut into slabs (MpmBodies::distribute)
   FemPartition part_;
   std::unique_ptr<DeformationTerm<dim, dim + 1>> local_elasticity_;  // MPM + FEM: this rank's elements, global node ids
-  std::vector<char> fem_owned_;
-  Kokkos::View<long long*, MemSpace> force_ids_;  // contact_force_ids()  // MPM + FEM on several ranks: FEM nodes owned here
+  std::vector<char> fem_owned_;                   // MPM + FEM on several ranks: FEM nodes owned here
+  Kokkos::View<long long*, MemSpace> force_ids_;  // contact_force_ids()
+  bool contact_reported_ = false;
   Kokkos::View<LO*, MemSpace> local_dof_;
   Kokkos::View<double*, MemSpace> lx_, lxhat_, lmass_, ltarget_;
   Kokkos::View<int*, MemSpace> lpres_;

@@ -92,7 +92,6 @@ void Simulation<dim>::restore(const SimulationState<dim>& s) {
     from_host(p.body, s.body, "particle_body");
     from_host(p.material, s.material, "particle_material");
     Kokkos::fence();
-    mpm_->replace_particles(p);
     GridSpec<dim> g;
     for (int d = 0; d < dim; ++d) {
       g.origin(d) = s.grid_origin[d];
@@ -100,6 +99,7 @@ void Simulation<dim>::restore(const SimulationState<dim>& s) {
     }
     g.dx = s.grid_dx;
     mpm_->restore_grid(g, s.grid_extensions);
+    mpm_->replace_particles(p);  // (MPI: slabs cut on the checkpoint's grid)
   }
   time_ = s.time;
   step_ = s.step;

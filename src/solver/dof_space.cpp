@@ -32,6 +32,9 @@ template <int dim>
 void DofSpace<dim>::set_partition(std::vector<GO> global_nodes, const std::vector<char>& owned) {
   if (owned.size() != global_nodes.size())
     throw std::invalid_argument("DofSpace::set_partition: an owned flag per local node expected");
+  // The same nodes as before (an MPM step whose active set did not change):
+  // the maps, graph and factorisation may serve again.
+  if (n_owned_ >= 0 && global_nodes == global_nodes_ && owned == owned_nodes_) return;
   global_nodes_ = std::move(global_nodes);
   owned_nodes_ = owned;
   n_owned_ = static_cast<LO>(std::count_if(owned.begin(), owned.end(), [](char c) { return c != 0; }));
@@ -76,7 +79,14 @@ bool DofSpace<dim>::set_structure(LO n_nodes, const std::vector<const EnergyTerm
   if (distributed() && n_nodes != static_cast<LO>(global_nodes_.size()))
     throw std::invalid_argument("DofSpace::set_structure: " + std::to_string(n_nodes) +
                                 " nodes, but the partition has " + std::to_string(global_nodes_.size()));
-  const bool same = !A_.is_null() && !maps_stale_ && n_nodes == n_nodes_ && terms == terms_ && versions == versions_;
+  bool same = !A_.is_null() && !maps_stale_ && n_nodes == n_nodes_ && terms == terms_ && versions == versions_;
+  if (distributed()) {  // maps and graph are built collectively: every rank decides alike
+    const int mine[2] = {same ? 0 : 1, maps_stale_ || map_.is_null() ? 1 : 0};
+    int any[2] = {0, 0};
+    Teuchos::reduceAll(*comm_, Teuchos::REDUCE_MAX, 2, mine, any);
+    same = any[0] == 0;
+    maps_stale_ = any[1] != 0;
+  }
   terms_ = terms;
   versions_ = std::move(versions);
   if (same) {
