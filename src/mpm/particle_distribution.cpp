@@ -103,6 +103,42 @@ Kokkos::View<LO*, MemSpace> group_by_owner(const Particles<dim>& p, const Partic
 
 using Buffer = Kokkos::View<double**, Kokkos::LayoutRight, MemSpace>;
 
+// MPI's type of one row of `width` doubles: counts and displacements in rows
+// (int), so a rank may send up to 2^31 - 1 particles, not doubles.
+struct RowType {
+  MPI_Datatype t;
+  explicit RowType(int width) {
+    MPI_Type_contiguous(width, MPI_DOUBLE, &t);
+    MPI_Type_commit(&t);
+  }
+  ~RowType() { MPI_Type_free(&t); }
+  RowType(const RowType&) = delete;
+  RowType& operator=(const RowType&) = delete;
+};
+
+// Every rank's n_rows rows of `width` doubles (host, row-major) on `root`,
+// rank after rank (collective); the root checks that there are `expected`.
+std::vector<double> gather_rows(const double* rows, long long n_rows, int width, const Teuchos::Comm<int>& comm,
+                                int root, long long expected, const char* who) {
+  const int me = comm.getRank(), n = comm.getSize();
+  const RowType row(width);
+  const int mine = static_cast<int>(n_rows);
+  std::vector<int> counts(n, 0), disp(n, 0);
+  MPI_Comm c = raw(comm);
+  MPI_Gather(&mine, 1, MPI_INT, counts.data(), 1, MPI_INT, root, c);
+  long long total = 0;
+  for (int r = 0; r < n; ++r) {
+    disp[r] = static_cast<int>(total);
+    total += counts[r];
+  }
+  if (me == root && total != expected)
+    throw std::logic_error(std::string(who) + ": " + std::to_string(total) + " particles on the ranks, expected " +
+                           std::to_string(expected));
+  std::vector<double> out(me == root ? static_cast<std::size_t>(total) * width : 0);
+  MPI_Gatherv(rows, mine, row.t, out.data(), counts.data(), disp.data(), row.t, root, c);
+  return out;
+}
+
 }  // namespace
 
 template <int dim>
@@ -169,12 +205,13 @@ long long migrate_particles(Particles<dim>& p, Kokkos::View<long long*, MemSpace
   auto hb = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), buf);
   // Send counts (in doubles) and displacements into hb: rank me's own rows
   // come first, then ranks 0, 1, ... without me.
+  // Counts and displacements in particles (rows of nf doubles).
   std::vector<int> scount(n, 0), sdisp(n, 0), rcount(n, 0), rdisp(n, 0);
   long long row = count[me];
   for (int r = 0; r < n; ++r) {
     if (r == me) continue;
-    scount[r] = static_cast<int>(count[r] * nf);
-    sdisp[r] = static_cast<int>(row * nf);
+    scount[r] = static_cast<int>(count[r]);
+    sdisp[r] = static_cast<int>(row);
     row += count[r];
   }
   MPI_Comm c = raw(comm);
@@ -184,10 +221,11 @@ long long migrate_particles(Particles<dim>& p, Kokkos::View<long long*, MemSpace
     rdisp[r] = static_cast<int>(recv);
     recv += rcount[r];
   }
-  Kokkos::View<double**, Kokkos::LayoutRight, Kokkos::HostSpace> hr("mpm_migrate_recv", recv / nf, nf);
-  MPI_Alltoallv(hb.data(), scount.data(), sdisp.data(), MPI_DOUBLE, hr.data(), rcount.data(), rdisp.data(),
-                MPI_DOUBLE, c);
-  const std::size_t kept = static_cast<std::size_t>(count[me]), arrived = static_cast<std::size_t>(recv / nf);
+  Kokkos::View<double**, Kokkos::LayoutRight, Kokkos::HostSpace> hr("mpm_migrate_recv", recv, nf);
+  const RowType particle(nf);
+  MPI_Alltoallv(hb.data(), scount.data(), sdisp.data(), particle.t, hr.data(), rcount.data(), rdisp.data(),
+                particle.t, c);
+  const std::size_t kept = static_cast<std::size_t>(count[me]), arrived = static_cast<std::size_t>(recv);
   Particles<dim> out = allocate_particles<dim>(kept + arrived);
   Kokkos::View<long long*, MemSpace> out_ids("mpm_particle_ids", kept + arrived);
   unpack<dim>(Kokkos::subview(buf, std::make_pair(std::size_t(0), kept), Kokkos::ALL()), kept, out, out_ids, 0, false);
@@ -204,7 +242,7 @@ long long migrate_particles(Particles<dim>& p, Kokkos::View<long long*, MemSpace
 template <int dim>
 Particles<dim> gather_particles(const Particles<dim>& p, Kokkos::View<const long long*, MemSpace> ids,
                                 long long n_total, const Teuchos::Comm<int>& comm, int root) {
-  const int me = comm.getRank(), n = comm.getSize();
+  const int me = comm.getRank();
   constexpr int nf = kFields<dim>;
   const LO np = static_cast<LO>(p.size());
   Kokkos::View<LO*, MemSpace> order("mpm_gather_order", np);
@@ -213,20 +251,8 @@ Particles<dim> gather_particles(const Particles<dim>& p, Kokkos::View<const long
   Buffer buf("mpm_gather_buffer", np, nf);
   pack<dim>(p, ids, order, buf);
   auto hb = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), buf);
-  int mine = static_cast<int>(np) * nf;
-  std::vector<int> counts(n, 0), disp(n, 0);
-  MPI_Comm c = raw(comm);
-  MPI_Gather(&mine, 1, MPI_INT, counts.data(), 1, MPI_INT, root, c);
-  long long total = 0;
-  for (int r = 0; r < n; ++r) {
-    disp[r] = static_cast<int>(total);
-    total += counts[r];
-  }
-  if (me == root && total != n_total * nf)
-    throw std::logic_error("gather_particles: " + std::to_string(total / nf) + " particles on the ranks, expected " +
-                           std::to_string(n_total));
-  Kokkos::View<double**, Kokkos::LayoutRight, Kokkos::HostSpace> hr("mpm_gather_recv", me == root ? n_total : 0, nf);
-  MPI_Gatherv(hb.data(), mine, MPI_DOUBLE, hr.data(), counts.data(), disp.data(), MPI_DOUBLE, root, c);
+  const std::vector<double> all = gather_rows(hb.data(), np, nf, comm, root, n_total, "gather_particles");
+  Kokkos::View<const double**, Kokkos::LayoutRight, Kokkos::HostSpace> hr(all.data(), me == root ? n_total : 0, nf);
   if (me != root) return allocate_particles<dim>(0);
   Particles<dim> out = allocate_particles<dim>(n_total);
   auto rb = Kokkos::create_mirror_view_and_copy(MemSpace(), hr);
@@ -238,7 +264,7 @@ Particles<dim> gather_particles(const Particles<dim>& p, Kokkos::View<const long
 std::vector<double> gather_particle_values(Kokkos::View<const double*, MemSpace> values, int k,
                                            Kokkos::View<const long long*, MemSpace> ids, long long n_total,
                                            const Teuchos::Comm<int>& comm, int root) {
-  const int me = comm.getRank(), n = comm.getSize();
+  const int me = comm.getRank();
   const std::size_t np = ids.extent(0);
   if (values.extent(0) < np * k) throw std::logic_error("gather_particle_values: fewer values than particles");
   // Rows (id, k values) of this rank's particles.
@@ -249,21 +275,9 @@ std::vector<double> gather_particle_values(Kokkos::View<const double*, MemSpace>
         for (int j = 0; j < k; ++j) buf(q, 1 + j) = values(q * k + j);
       });
   auto hb = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), buf);
-  int mine = static_cast<int>(np) * (k + 1);
-  std::vector<int> counts(n, 0), disp(n, 0);
-  MPI_Comm c = raw(comm);
-  MPI_Gather(&mine, 1, MPI_INT, counts.data(), 1, MPI_INT, root, c);
-  long long total = 0;
-  for (int r = 0; r < n; ++r) {
-    disp[r] = static_cast<int>(total);
-    total += counts[r];
-  }
-  std::vector<double> recv(me == root ? static_cast<std::size_t>(total) : 0);
-  MPI_Gatherv(hb.data(), mine, MPI_DOUBLE, recv.data(), counts.data(), disp.data(), MPI_DOUBLE, root, c);
+  const std::vector<double> recv = gather_rows(hb.data(), static_cast<long long>(np), k + 1, comm, root, n_total,
+                                               "gather_particle_values");
   if (me != root) return {};
-  if (total != n_total * (k + 1))
-    throw std::logic_error("gather_particle_values: " + std::to_string(total / (k + 1)) + " particles, expected " +
-                           std::to_string(n_total));
   std::vector<double> out(static_cast<std::size_t>(n_total) * k);
   for (long long r = 0; r < n_total; ++r) {
     const double* row = recv.data() + r * (k + 1);

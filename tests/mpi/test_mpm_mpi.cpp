@@ -24,6 +24,7 @@
 #include <cmath>
 #include <mpi.h>
 
+#include "common/mpi_checks.hpp"
 #include "common/mpm_fixtures.hpp"
 #include "io/scene.hpp"
 
@@ -40,14 +41,7 @@ struct Result {
   std::size_t local_particles = 0;
 };
 
-void expect_same_on_every_rank(const Comm& world, const std::vector<int>& iterations) {
-  for (int it : iterations) {
-    int lo = 0, hi = 0;
-    Teuchos::reduceAll(world, Teuchos::REDUCE_MIN, it, Teuchos::outArg(lo));
-    Teuchos::reduceAll(world, Teuchos::REDUCE_MAX, it, Teuchos::outArg(hi));
-    EXPECT_EQ(lo, hi);
-  }
-}
+using fixtures::expect_same_on_every_rank;
 
 template <int dim>
 Result run_steps(Simulation<dim>& sim, int steps) {

@@ -16,6 +16,7 @@
 #include <mpi.h>
 
 #include "common/fem_fixtures.hpp"
+#include "common/mpi_checks.hpp"
 #include "common/mpm_fixtures.hpp"
 
 using namespace bfemp;
@@ -28,15 +29,7 @@ struct Result {
   double kinetic = 0, elastic = 0;
 };
 
-// Every rank took the same Newton iterations in every step.
-void expect_same_on_every_rank(const Comm& world, const std::vector<int>& iterations) {
-  for (int it : iterations) {
-    int lo = 0, hi = 0;
-    Teuchos::reduceAll(world, Teuchos::REDUCE_MIN, it, Teuchos::outArg(lo));
-    Teuchos::reduceAll(world, Teuchos::REDUCE_MAX, it, Teuchos::outArg(hi));
-    EXPECT_EQ(lo, hi);
-  }
-}
+using fixtures::expect_same_on_every_rank;
 
 // Six steps: the Newton iterations of each, the final energies and state.
 template <int dim>
