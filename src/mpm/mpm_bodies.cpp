@@ -93,10 +93,10 @@ void MpmBodies<dim>::resize_stencils() {
 }
 
 template <int dim>
-double MpmBodies<dim>::all(double v, int op) const {
+double MpmBodies<dim>::all(double v, Teuchos::EReductionType op) const {
   if (!distributed_) return v;
   double g = v;
-  Teuchos::reduceAll(*comm_, static_cast<Teuchos::EReductionType>(op), v, Teuchos::outArg(g));
+  Teuchos::reduceAll(*comm_, op, v, Teuchos::outArg(g));
   return g;
 }
 

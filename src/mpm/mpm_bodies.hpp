@@ -19,6 +19,7 @@
 #include <vector>
 
 #include <Teuchos_Comm.hpp>
+#include <Teuchos_EReductionType.hpp>
 #include <Teuchos_RCP.hpp>
 
 #include "kernels/mpm_transfer.hpp"
@@ -169,7 +170,7 @@ class MpmBodies {
   void check_inside_grid(long step);
   void number_owned_first(LO first);
   void sum_shared_nodes();
-  double all(double v, int op) const;
+  double all(double v, Teuchos::EReductionType op) const;  // over the ranks (distributed)
 };
 
 }  // namespace bfemp

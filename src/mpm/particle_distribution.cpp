@@ -1,11 +1,12 @@
 #include "mpm/particle_distribution.hpp"
 
 #include <Teuchos_CommHelpers.hpp>
-#include <Teuchos_DefaultMpiComm.hpp>
 #include <algorithm>
 #include <cmath>
 #include <mpi.h>
 #include <stdexcept>
+
+#include "core/mpi_comm.hpp"
 
 namespace bfemp {
 
@@ -15,12 +16,6 @@ namespace {
 // (ids and indices are exact in a double below 2^53).
 template <int dim>
 constexpr int kFields = 1 + 2 * dim + 2 + 2 * dim * dim + 2;
-
-MPI_Comm raw(const Teuchos::Comm<int>& comm) {
-  const auto* m = dynamic_cast<const Teuchos::MpiComm<int>*>(&comm);
-  if (!m) throw std::logic_error("particle distribution: the communicator is not an MPI one");
-  return (*m->getRawMpiComm())();
-}
 
 // buf(k, :) = particle order(k) of p.
 template <int dim>
@@ -124,7 +119,7 @@ std::vector<double> gather_rows(const double* rows, long long n_rows, int width,
   const RowType row(width);
   const int mine = static_cast<int>(n_rows);
   std::vector<int> counts(n, 0), disp(n, 0);
-  MPI_Comm c = raw(comm);
+  MPI_Comm c = raw_mpi_comm(comm);
   MPI_Gather(&mine, 1, MPI_INT, counts.data(), 1, MPI_INT, root, c);
   long long total = 0;
   for (int r = 0; r < n; ++r) {
@@ -214,7 +209,7 @@ long long migrate_particles(Particles<dim>& p, Kokkos::View<long long*, MemSpace
     sdisp[r] = static_cast<int>(row);
     row += count[r];
   }
-  MPI_Comm c = raw(comm);
+  MPI_Comm c = raw_mpi_comm(comm);
   MPI_Alltoall(scount.data(), 1, MPI_INT, rcount.data(), 1, MPI_INT, c);
   long long recv = 0;
   for (int r = 0; r < n; ++r) {

@@ -68,6 +68,7 @@ void DofSpace<dim>::build_maps() {
   import_ = Teuchos::rcp(new Tpetra::Import<LO, GO, Node>(map_, overlap_map_));
   rhs_overlap_ = Teuchos::rcp(new Vector(overlap_map_));
   x_overlap_ = Teuchos::rcp(new Vector(overlap_map_));
+  owned_tmp_ = Teuchos::rcp(new Vector(map_));
   maps_stale_ = false;
 }
 
@@ -135,6 +136,7 @@ void DofSpace<dim>::rebuild() {
     A_overlap_->fillComplete(map_, map_);
     A_ = Teuchos::rcp(new Matrix(Teuchos::RCP<const Graph>(G)));
     A_->fillComplete(map_, map_);
+    matrix_sum_ = std::make_unique<OverlapMatrixSum>(*A_overlap_, *A_, *export_);
     const LO n_own = static_cast<LO>(map_->getNodeNumElements());
     diag_col_ = Kokkos::View<LO*, MemSpace>("dof_diag_col", n_own);
     auto dh = Kokkos::create_mirror_view(diag_col_);
@@ -203,8 +205,7 @@ void DofSpace<dim>::end_assembly(MaskView prescribed, ConstDofView dx_prescribed
   b.putScalar(0.0);
   b.doExport(*rhs_overlap_, *export_, Tpetra::ADD);
   A_->resumeFill();
-  A_->setAllToScalar(0.0);
-  A_->doExport(*A_overlap_, *export_, Tpetra::ADD);
+  matrix_sum_->sum(*A_overlap_, *A_);
   // Constraint rows on the owned side (owned row r is local DOF owned_dofs(r)).
   auto lcl = A_->getLocalMatrixDevice();
   auto bv = Kokkos::subview(b.getLocalViewDevice(Tpetra::Access::ReadWrite), Kokkos::ALL(), 0);
@@ -241,9 +242,9 @@ void DofSpace<dim>::sum_shared(DofView local) {
     auto rv = Kokkos::subview(rhs_overlap_->getLocalViewDevice(Tpetra::Access::OverwriteAll), Kokkos::ALL(), 0);
     Kokkos::deep_copy(rv, local);
   }
-  Vector owned(map_);
-  owned.doExport(*rhs_overlap_, *export_, Tpetra::ADD);
-  to_local(owned, local);
+  owned_tmp_->putScalar(0.0);
+  owned_tmp_->doExport(*rhs_overlap_, *export_, Tpetra::ADD);
+  to_local(*owned_tmp_, local);
 }
 
 template class DofSpace<2>;

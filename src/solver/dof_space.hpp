@@ -18,8 +18,10 @@
 // (first) and its ghosts, each with a global node id. Every local View (x,
 // gradient, rhs, direction) covers all local nodes; the terms assemble into
 // an overlap matrix (rows and columns: all local DOFs, local column ids ==
-// local DOF ids, so the sink is the same) and one Export with ADD moves the
-// sums into the owned matrix and right-hand side the linear solver sees; the
+// local DOF ids, so the sink is the same); a value exchange planned with the
+// graph (OverlapMatrixSum) sums the overlap matrices into the owned matrix and
+// an Export with ADD the right-hand sides into the owned one the linear
+// solver sees; the
 // solution comes back to the ghosts with one Import. Constraint rows are
 // written once, on the owned side. The owned nodes may come first (n_owned)
 // or lie anywhere among the local ones (a mask: MPM grid nodes beside a
@@ -28,9 +30,11 @@
 #include <Tpetra_Export_decl.hpp>
 #include <Tpetra_Import_decl.hpp>
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 #include "solver/energy_term.hpp"
+#include "solver/overlap_matrix_sum.hpp"
 #include "solver/slip_constraints.hpp"
 #include "solver/tpetra_types.hpp"
 
@@ -119,8 +123,9 @@ class DofSpace {
   Teuchos::RCP<const Map> map_, overlap_map_;
   Teuchos::RCP<Matrix> A_, A_overlap_;  // A_overlap_: the terms' sink (distributed)
   Teuchos::RCP<const Tpetra::Export<LO, GO, Node>> export_;
+  std::unique_ptr<OverlapMatrixSum> matrix_sum_;  // A_overlap_ of all ranks -> A_, planned per graph
   Teuchos::RCP<const Tpetra::Import<LO, GO, Node>> import_;
-  Teuchos::RCP<Vector> rhs_overlap_, x_overlap_;
+  Teuchos::RCP<Vector> rhs_overlap_, x_overlap_, owned_tmp_;  // owned_tmp_: sum_shared
   Kokkos::View<LO*, MemSpace> diag_col_;  // distributed: column id of each owned row's diagonal
   void build_maps();
   std::vector<const EnergyTerm<dim>*> terms_;

@@ -264,3 +264,27 @@ TEST(MpmMpi, ParticleStartingInsideAnFemBodyStopsEveryRank) {
   Teuchos::reduceAll(*world, Teuchos::REDUCE_MAX, len, Teuchos::outArg(hi));
   EXPECT_EQ(lo, hi) << "the ranks stopped with different messages";
 }
+
+// 'MPM/when particles leave: extend' on 2 ranks: both blocks move right
+// (3 and 2 m/s) and leave a tight grid on one rank's side; every rank grows the grid alike (bounding box
+// of all ranks' particles), and the run equals one rank alone, the same
+// number of extensions included.
+TEST(MpmMpi, GridExtendedAlikeOnEveryRankEqualsOneRank) {
+  auto world = Tpetra::getDefaultComm();
+  Teuchos::RCP<const Comm> self = Teuchos::rcp(new Teuchos::MpiComm<int>(MPI_COMM_SELF));
+  auto setup = [] {
+    auto s = two_blocks();
+    s.mpm->grid = grid_covering<2>(Vec<2>(0.3, 0.2), Vec<2>(1.5, 0.6), 0.05);  // the blocks just fit
+    s.mpm->extend_domain = true;
+    const std::size_t n = s.mpm->particles.size();  // the right block (second half) moves too
+    set_velocity<2>(s.mpm->particles, n / 2, n, Vec<2>(2.0, 0.0));
+    return s;
+  };
+  Simulation<2> dist(setup(), world);
+  const Result d = run_steps(dist, 40);
+  Simulation<2> alone(setup(), self);
+  const Result s = run_steps(alone, 40);
+  EXPECT_GT(alone.mpm()->domain_extensions(), 0) << "the grid never grew: the test tests nothing";
+  EXPECT_EQ(dist.mpm()->domain_extensions(), alone.mpm()->domain_extensions());
+  compare<2>(*world, d, s, 1e-9, "2D blocks, growing grid");
+}

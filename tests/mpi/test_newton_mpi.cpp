@@ -12,10 +12,12 @@
 #include <Teuchos_DefaultSerialComm.hpp>
 #include <Tpetra_Core.hpp>
 #include <cmath>
+#include <map>
 
 #include "fem/fem_mesh.hpp"
 #include "fem/fem_partition.hpp"
 #include "common/fem_fixtures.hpp"
+#include "solver/dof_space.hpp"
 #include "solver/newton.hpp"
 
 using namespace bfemp;
@@ -143,7 +145,118 @@ void distributed_equals_serial(const std::string& prec, double h) {
               << st_ref.iterations << "), CG iterations " << st.linear_iterations << "\n";
 }
 
+// The assembled system of the deformation term at x (the mesh's node
+// positions plus a shear), bottom DOFs prescribed with dxp = 1e-3 sin(global
+// DOF): matrix rows and b by global DOF id, for this rank's owned rows.
+struct RowSystem {
+  std::map<GO, std::map<GO, double>> rows;
+  std::map<GO, double> b;
+};
+
+template <int dim>
+RowSystem assemble_rows(const FemMesh<dim>& mesh, const std::vector<GO>& global_ids, LO n_owned,
+                        const std::vector<char>& bottom, const Teuchos::RCP<const Comm>& comm, bool distributed,
+                        int assemblies) {
+  const std::size_t n = mesh.num_nodes(), nd = n * dim;
+  View1 x("x", nd), grad("grad", nd), rhs("rhs", nd), dxp("dxp", nd);
+  Kokkos::View<int*, MemSpace> pres("pres", nd);
+  auto X = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), mesh.rest_position);
+  auto xh = Kokkos::create_mirror_view(x);
+  auto dh = Kokkos::create_mirror_view(dxp);
+  auto ph = Kokkos::create_mirror_view(pres);
+  for (std::size_t a = 0; a < n; ++a)
+    for (int c = 0; c < dim; ++c) {
+      const std::size_t i = a * dim + c;
+      const GO gi = global_ids[a] * dim + c;
+      xh(i) = X(i) + (c == 0 ? 0.2 * X(a * dim + 1) * X(a * dim + 1) : 0.05 * std::sin(7.0 * X(a * dim)));
+      ph(i) = bottom[global_ids[a]] ? 1 : 0;
+      dh(i) = ph(i) ? 1e-3 * std::sin(static_cast<double>(gi)) : 0.0;
+    }
+  Kokkos::deep_copy(x, xh);
+  Kokkos::deep_copy(dxp, dh);
+  Kokkos::deep_copy(pres, ph);
+  DeformationTerm<dim, dim + 1> term("fem", mesh.elements);
+  DofSpace<dim> dofs(comm);
+  if (distributed) dofs.set_partition(global_ids, n_owned);
+  dofs.set_structure(static_cast<LO>(n), {&term});
+  Vector b(dofs.map());
+  for (int k = 0; k < assemblies; ++k) {  // the later ones reuse the graph and the exchange plan
+    Kokkos::deep_copy(grad, 0.0);
+    Kokkos::deep_copy(rhs, 0.0);
+    dofs.begin_assembly();
+    term.assemble(x, dofs.sink(0.5, grad, rhs, pres, dxp));
+    dofs.end_assembly(pres, dxp, rhs, b);
+  }
+  RowSystem s;
+  const auto A = dofs.matrix();
+  const auto& map = *dofs.map();
+  auto bv = b.getLocalViewHost(Tpetra::Access::ReadOnly);
+  std::size_t len = A->getNodeMaxNumRowEntries();
+  std::vector<GO> cols(len);
+  std::vector<double> vals(len);
+  for (LO r = 0; r < static_cast<LO>(map.getNodeNumElements()); ++r) {
+    const GO g = map.getGlobalElement(r);
+    std::size_t nr = 0;
+    A->getGlobalRowCopy(g, cols, vals, nr);
+    for (std::size_t k = 0; k < nr; ++k) s.rows[g][cols[k]] += vals[k];
+    s.b[g] = bv(r, 0);
+  }
+  return s;
+}
+
+// The owned rows of the distributed system equal the serial system's rows,
+// entry by entry (prescribed rows and columns included): the overlap matrices
+// of all ranks sum into the owned matrix, on the first assembly of a graph and
+// on the following ones (the value exchange planned once).
+template <int dim>
+void distributed_system_equals_serial(double h) {
+  auto comm = Tpetra::getDefaultComm();
+  auto setup = fixtures::block_setup<dim>(h);
+  const FemMesh<dim> mesh = build_fem_mesh<dim>(setup.bodies, setup.materials);
+  const LO nn = mesh.num_nodes();
+  std::vector<char> bottom(nn, 0);
+  for (long long v : setup.bodies[0].mesh.node_sets.at("bottom")) bottom[v] = 1;
+  std::vector<GO> all(nn);
+  for (LO a = 0; a < nn; ++a) all[a] = a;
+  const RowSystem ref = assemble_rows<dim>(mesh, all, nn, bottom, Teuchos::rcp(new Teuchos::SerialComm<int>()), false, 1);
+  const FemPartition part = partition_fem_mesh<dim>(mesh, comm);
+  const FemMesh<dim> local = local_fem_mesh<dim>(mesh, part);
+  for (int assemblies : {1, 3}) {
+    const RowSystem d = assemble_rows<dim>(local, part.nodes, part.n_owned, bottom, comm, true, assemblies);
+    double scale = 0, err = 0, berr = 0;
+    long entries = 0, prescribed_rows = 0;
+    for (const auto& [g, row] : d.rows) {
+      const auto& rr = ref.rows.at(g);
+      EXPECT_EQ(row.size(), rr.size()) << "row " << g;
+      for (const auto& [c, v] : rr) {
+        const auto it = row.find(c);
+        const double got = it == row.end() ? 0.0 : it->second;
+        err = std::max(err, std::abs(got - v));
+        scale = std::max(scale, std::abs(v));
+        ++entries;
+      }
+      berr = std::max(berr, std::abs(d.b.at(g) - ref.b.at(g)));
+      if (bottom[g / dim]) ++prescribed_rows;
+    }
+    long total = 0, total_prescribed = 0;
+    Teuchos::reduceAll(*comm, Teuchos::REDUCE_SUM, entries, Teuchos::outArg(total));
+    Teuchos::reduceAll(*comm, Teuchos::REDUCE_SUM, prescribed_rows, Teuchos::outArg(total_prescribed));
+    long ref_entries = 0;
+    for (const auto& [g, row] : ref.rows) ref_entries += static_cast<long>(row.size());
+    EXPECT_EQ(total, ref_entries) << "the owned rows of all ranks cover the serial matrix";
+    EXPECT_GT(total_prescribed, 0);
+    EXPECT_LE(err, 1e-13 * scale) << dim << "D, " << assemblies << " assemblies, " << comm->getSize() << " ranks";
+    double bscale = 0;
+    for (const auto& [g, v] : ref.b) bscale = std::max(bscale, std::abs(v));
+    EXPECT_GT(bscale, 0.0);
+    EXPECT_LE(berr, 1e-13 * bscale);
+  }
+}
+
 }  // namespace
+
+TEST(NewtonMpi, DistributedSystemEqualsSerialEntryByEntry2D) { distributed_system_equals_serial<2>(0.05); }
+TEST(NewtonMpi, DistributedSystemEqualsSerialEntryByEntry3D) { distributed_system_equals_serial<3>(0.2); }
 
 TEST(NewtonMpi, PartitionCoversEveryNodeAndElementOnce) {
   auto comm = Tpetra::getDefaultComm();
