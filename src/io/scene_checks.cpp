@@ -99,6 +99,9 @@ void check_mpm(const ParameterList& raw, int dim) {
   const int ppc = m.get<int>("particles per cell");
   const bool ok = dim == 2 ? (ppc == 1 || ppc == 4 || ppc == 9 || ppc == 16) : (ppc == 1 || ppc == 8 || ppc == 27);
   if (!ok) bad("MPM/particles per cell", std::to_string(ppc), dim == 2 ? "1, 4, 9 or 16" : "1, 8 or 27");
+  const double rb = m.get<double>("rebalance above");
+  if (!(rb == 0 || (rb > 1 && std::isfinite(rb))))
+    bad("MPM/rebalance above", num(rb), "0 (never) or a finite imbalance > 1 (largest / mean particles per rank)");
 }
 
 void check_contact(const ParameterList& raw) {

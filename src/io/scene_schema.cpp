@@ -186,6 +186,9 @@ Teuchos::RCP<const ParameterList> scene_schema() {
          "a particle whose B-spline stencil leaves the grid domain: stop with an error naming it and "
          "the step, or extend the grid by whole cells before the step",
          tuple<std::string>("error", "extend"));
+  mpm.set("rebalance above", 1.2,
+          "MPI: new slab cuts when the ranks' particle counts reach largest / mean > this after a step "
+          "(0: never; else > 1)");
   pl->sublist("MPM Bodies", false, "named MPM bodies (particles)").disableRecursiveValidation();
   auto& ex = pl->sublist("Explicit", false, "explicit multimaterial MPM (Solver: explicit; paper 001)");
   choice(ex, "shape functions", "uGIMP", "grid shape functions", tuple<std::string>("uGIMP", "quadratic B-spline"));

@@ -124,9 +124,32 @@ void MpmBodies<dim>::replace_particles(const Particles<dim>& all) {
 template <int dim>
 long long MpmBodies<dim>::migrate() {
   if (!distributed_) return 0;
-  const long long moved = migrate_particles(setup_.particles, ids_, slabs_, *comm_);
+  long long moved = migrate_particles(setup_.particles, ids_, slabs_, *comm_);
+  moved += rebalance();
   if (moved > 0) resize_stencils();
   migrated_ += moved;
+  return moved;
+}
+
+template <int dim>
+long long MpmBodies<dim>::rebalance() {
+  const double mine = static_cast<double>(setup_.particles.size());
+  const double largest = all(mine, Teuchos::REDUCE_MAX);
+  const double mean = static_cast<double>(n_total_) / comm_->getSize();
+  imbalance_ = mean > 0 ? largest / mean : 1.0;
+  const double above = setup_.rebalance_above;
+  if (!(above > 0) || imbalance_ <= above || imbalance_ <= retry_above_) return 0;
+  long long new_largest = 0;
+  ParticleSlabs<dim> s = rebalanced_slabs(setup_.particles, slabs_, setup_.grid, *comm_, new_largest);
+  if (static_cast<double>(new_largest) > 0.95 * largest) {  // a cell layer too crowded to split better
+    retry_above_ = 1.05 * imbalance_;
+    return 0;
+  }
+  slabs_ = s;
+  retry_above_ = 0.0;
+  ++rebalances_;
+  const long long moved = migrate_particles(setup_.particles, ids_, slabs_, *comm_);
+  imbalance_ = mean > 0 ? all(static_cast<double>(setup_.particles.size()), Teuchos::REDUCE_MAX) / mean : 1.0;
   return moved;
 }
 

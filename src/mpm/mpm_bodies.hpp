@@ -39,6 +39,10 @@ struct MpmSetup {
   // particle and step; true: the grid grows by whole cells before the step
   // (scene key 'MPM/when particles leave: extend').
   bool extend_domain = false;
+  // MPI: new slab cuts when, after a step's migration, the largest slab holds
+  // more than rebalance_above x the mean particle count (0: never; scene key
+  // 'MPM/rebalance above').
+  double rebalance_above = 1.2;
 };
 
 // MPM elasticity: deformation stencils of the particles; the graph couplings
@@ -99,9 +103,16 @@ class MpmBodies {
   // Restart: the whole particle set of a checkpoint (re-cut when distributed).
   void replace_particles(const Particles<dim>& all);
   // Particles that left this rank's slab go to their owners (collective; at
-  // the end of a step). Returns the number moved over all ranks.
+  // the end of a step); then, when the slabs' counts differ more than
+  // rebalance_above allows, new cuts (rebalanced_slabs) and a second exchange.
+  // A rebalance that would not lower the largest slab by 5 % is not made, and
+  // not tried again until the imbalance has grown by 5 %. Returns the number
+  // moved over all ranks.
   long long migrate();
   long long migrated_particles() const { return migrated_; }  // since construction, all ranks
+  int rebalances() const { return rebalances_; }
+  // max / mean of the ranks' particle counts after the last migrate() (1 on one rank).
+  double imbalance() const { return imbalance_; }
   // Particles on all ranks; each particle's global id (its scene index).
   long long total_particles() const { return n_total_; }
   Kokkos::View<const long long*, MemSpace> particle_ids() const { return ids_; }
@@ -162,6 +173,9 @@ class MpmBodies {
   ParticleSlabs<dim> slabs_;
   Kokkos::View<long long*, MemSpace> ids_;
   long long n_total_ = 0, migrated_ = 0;
+  int rebalances_ = 0;
+  double imbalance_ = 1.0, retry_above_ = 0.0;  // retry_above_: a failed rebalance waits for more imbalance
+  long long rebalance();
   LO owned_ = 0;
   std::vector<GO> global_nodes_;
   struct Halo;

@@ -165,6 +165,49 @@ ParticleSlabs<dim> balanced_slabs(const Particles<dim>& all, const GridSpec<dim>
 }
 
 template <int dim>
+ParticleSlabs<dim> rebalanced_slabs(const Particles<dim>& p, const ParticleSlabs<dim>& old, const GridSpec<dim>& grid,
+                                    const Teuchos::Comm<int>& comm, long long& largest) {
+  const int axis = old.axis, nranks = comm.getSize();
+  const int layers = std::max(grid.n_cells[axis], 1);
+  const double o = grid.origin(axis), dx = grid.dx;
+  Kokkos::View<long long*, MemSpace> hist("mpm_slab_histogram", layers);
+  const auto x = p.x;
+  Kokkos::parallel_for(
+      "mpm_slab_histogram", Kokkos::RangePolicy<ExecSpace>(0, p.size()), KOKKOS_LAMBDA(const LO q) {
+        const double c = std::floor((x(q, axis) - o) / dx);
+        const int k = !(c > 0.0) ? 0 : c >= layers - 1 ? layers - 1 : static_cast<int>(c);
+        Kokkos::atomic_add(&hist(k), 1LL);
+      });
+  auto h = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), hist);
+  std::vector<long long> mine(h.data(), h.data() + layers), all(layers, 0);
+  Teuchos::reduceAll(comm, Teuchos::REDUCE_SUM, layers, mine.data(), all.data());
+  // below[k]: particles under face k (layers 0..k-1).
+  std::vector<long long> below(layers + 1, 0);
+  for (int k = 0; k < layers; ++k) below[k + 1] = below[k] + all[k];
+  const double total = static_cast<double>(below[layers]);
+  ParticleSlabs<dim> s;
+  s.axis = axis;
+  s.nranks = nranks;
+  s.cuts = Kokkos::View<double*, MemSpace>("mpm_slab_cuts", std::max(nranks - 1, 0));
+  auto ch = Kokkos::create_mirror_view(s.cuts);
+  int face = 0;
+  long long prev = 0;
+  largest = 0;
+  for (int r = 1; r < nranks; ++r) {  // the face whose count below is nearest r / nranks of all
+    const double target = total * r / nranks;
+    while (face < layers && std::abs(static_cast<double>(below[face + 1]) - target) <=
+                                std::abs(static_cast<double>(below[face]) - target))
+      ++face;
+    ch(r - 1) = o + dx * face;
+    largest = std::max(largest, below[face] - prev);
+    prev = below[face];
+  }
+  largest = std::max(largest, below[layers] - prev);
+  Kokkos::deep_copy(s.cuts, ch);
+  return s;
+}
+
+template <int dim>
 Particles<dim> select_slab(const Particles<dim>& all, const ParticleSlabs<dim>& slabs, int rank,
                            Kokkos::View<long long*, MemSpace>& ids) {
   const LO np = static_cast<LO>(all.size());
@@ -284,6 +327,8 @@ std::vector<double> gather_particle_values(Kokkos::View<const double*, MemSpace>
 
 #define BFEMP_INSTANTIATE(D)                                                                                        \
   template ParticleSlabs<D> balanced_slabs<D>(const Particles<D>&, const GridSpec<D>&, int);                        \
+  template ParticleSlabs<D> rebalanced_slabs<D>(const Particles<D>&, const ParticleSlabs<D>&, const GridSpec<D>&,    \
+                                                const Teuchos::Comm<int>&, long long&);                             \
   template Particles<D> select_slab<D>(const Particles<D>&, const ParticleSlabs<D>&, int,                          \
                                        Kokkos::View<long long*, MemSpace>&);                                        \
   template long long migrate_particles<D>(Particles<D>&, Kokkos::View<long long*, MemSpace>&,                      \

@@ -44,6 +44,16 @@ struct ParticleSlabs {
 template <int dim>
 ParticleSlabs<dim> balanced_slabs(const Particles<dim>& all, const GridSpec<dim>& grid, int nranks);
 
+// Cuts along old.axis at cell faces that split the particles of all ranks
+// (p: this rank's) into slabs of about equal counts, from the particle count
+// of every cell layer summed over the ranks (collective: one sum of
+// grid.n_cells[axis] counts; particles outside the grid count in the first or
+// last layer). largest: the most particles a new slab holds. Work O(particles
+// / ranks + layers); for a rebalance, not for every step.
+template <int dim>
+ParticleSlabs<dim> rebalanced_slabs(const Particles<dim>& p, const ParticleSlabs<dim>& old, const GridSpec<dim>& grid,
+                                    const Teuchos::Comm<int>& comm, long long& largest);
+
 // The particles of `all` in slab `rank`, and their indices in `all` (ids).
 template <int dim>
 Particles<dim> select_slab(const Particles<dim>& all, const ParticleSlabs<dim>& slabs, int rank,

@@ -309,6 +309,12 @@ RunSummary run_dim(const Scene& scene, const std::string& dir, const Teuchos::RC
   s.wall_s = wall.seconds();
   for (const auto& [name, sec] : sim.newton().term_assembly_seconds()) s.term_assembly_s.emplace_back(name, sec);
   s.graph_builds = sim.newton().dof_space().graph_builds();
+  if (const auto* mpm = sim.mpm(); mpm && mpm->distributed()) {
+    s.mpm_ranks = comm->getSize();
+    s.migrations = mpm->migrated_particles();
+    s.rebalances = mpm->rebalances();
+    s.imbalance = mpm->imbalance();
+  }
   return s;
 }
 
@@ -389,6 +395,10 @@ RunSummary run_scene(const Scene& scene, const std::string& dir, const Teuchos::
   if (s.contact)
     log << "  contact: broad phase " << s.contact_broad_phase_s << " s, pair evaluation " << s.contact_eval_s
         << " s, CCD " << s.contact_ccd_s << " s (within the times above)\n";
+  if (s.mpm_ranks > 1)
+    log << "  MPM on " << s.mpm_ranks << " ranks      " << s.migrations << " particle migrations, " << s.rebalances
+        << " slab rebalance(s); particle imbalance at the end " << std::setprecision(3) << s.imbalance
+        << " (largest / mean per rank)\n";
   log << "  wall time           " << s.wall_s << " s\n"
       << "  frames written      " << s.frames << " (" << dir << "/bfemp.xdmf)\n"
       << "  checkpoint          " << dir << "/checkpoint.h5 (continue with: bfemp restart " << dir << ")\n";

@@ -28,6 +28,11 @@ struct RunSummary {
   long projected_retries = 0;  // steps redone with the projected Hessian
   long exact_hessian_iterations = 0, projection_fallbacks = 0;  // Newton/hessian: exact-if-definite
   std::vector<std::pair<std::string, double>> term_assembly_s;  // per energy term
+  // MPI, MPM bodies in slabs: ranks, particle migrations, slab rebalances and
+  // the particle imbalance (largest / mean per rank) at the end.
+  int mpm_ranks = 1, rebalances = 0;
+  long long migrations = 0;
+  double imbalance = 1.0;
 };
 
 struct RunOptions {

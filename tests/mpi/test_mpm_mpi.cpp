@@ -39,6 +39,7 @@ struct Result {
   std::array<double, 3> momentum{0, 0, 0}, momentum0{0, 0, 0};
   long long migrated = 0;
   std::size_t local_particles = 0;
+  double worst_imbalance = 1.0;  // largest / mean particles per rank, the worst step end
 };
 
 using fixtures::expect_same_on_every_rank;
@@ -53,6 +54,7 @@ Result run_steps(Simulation<dim>& sim, int steps) {
     r.kinetic = rep.kinetic;
     r.elastic = rep.elastic;
     r.momentum = rep.momentum;
+    r.worst_imbalance = std::max(r.worst_imbalance, sim.mpm()->imbalance());
   }
   const Particles<dim> p = sim.mpm()->gathered_particles();
   auto x = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), p.x);
@@ -287,4 +289,38 @@ TEST(MpmMpi, GridExtendedAlikeOnEveryRankEqualsOneRank) {
   EXPECT_GT(alone.mpm()->domain_extensions(), 0) << "the grid never grew: the test tests nothing";
   EXPECT_EQ(dist.mpm()->domain_extensions(), alone.mpm()->domain_extensions());
   compare<2>(*world, d, s, 1e-9, "2D blocks, growing grid");
+}
+
+// Slab rebalancing ('MPM/rebalance above'): both blocks fly right at 2 m/s
+// for 0.3 s; the left one crosses the start cut (x = 1.15, between them), so
+// that without new cuts the right slab ends with 2/3 of the particles
+// (imbalance 1.33). With 1.2 the cuts move and no step ends above 1.2; with 0
+// they never move. Both runs equal one rank alone.
+TEST(MpmMpi, SlabsRebalanceWhenParticlesCrowdOneRank) {
+  auto world = Tpetra::getDefaultComm();
+  Teuchos::RCP<const Comm> self = Teuchos::rcp(new Teuchos::MpiComm<int>(MPI_COMM_SELF));
+  auto setup = [](double rebalance_above) {
+    auto s = two_blocks();
+    s.mpm->rebalance_above = rebalance_above;
+    set_velocity<2>(s.mpm->particles, 0, s.mpm->particles.size(), Vec<2>(2.0, 0.0));
+    return s;
+  };
+  Simulation<2> alone(setup(1.2), self);
+  const Result s = run_steps(alone, 60);
+  for (double above : {1.2, 0.0}) {
+    Simulation<2> dist(setup(above), world);
+    const Result d = run_steps(dist, 60);
+    compare<2>(*world, d, s, 1e-9, above > 0 ? "2D blocks, rebalanced slabs" : "2D blocks, fixed slabs");
+    if (world->getSize() == 1) continue;
+    if (above > 0) {
+      EXPECT_GE(dist.mpm()->rebalances(), 1);
+      EXPECT_LE(d.worst_imbalance, 1.2);
+    } else {
+      EXPECT_EQ(dist.mpm()->rebalances(), 0);
+      EXPECT_GT(dist.mpm()->imbalance(), 1.25);
+    }
+    if (world->getRank() == 0)
+      std::cout << "rebalance above " << above << ": " << dist.mpm()->rebalances() << " rebalance(s), worst imbalance "
+                << d.worst_imbalance << ", at the end " << dist.mpm()->imbalance() << "\n";
+  }
 }
