@@ -186,6 +186,9 @@ bfemp:
   expect_message(error_of(with("grid spacing: 0.05", "grid spacing: 0.0")), {"MPM/grid spacing", "0", "dx > 0"});
   expect_message(error_of(with("particles per cell: 4", "particles per cell: 5")),
                  {"MPM/particles per cell", "5", "1, 4, 9 or 16"});
+  for (const char* v : {"1", "0.5", "-1"})
+    expect_message(error_of(with("particles per cell: 4", std::string("particles per cell: 4\n    rebalance above: ") + v)),
+                   {"MPM/rebalance above", v, "0 (never) or a finite imbalance > 1"});
   expect_message(error_of(with("domain max: [1.0, 1.0]", "domain max: [1.0]")), {"MPM/domain max", "2 components"});
   expect_message(error_of(with("shape: box", "shape: blob")), {"MPM Bodies/block/shape", "blob"});
 }
