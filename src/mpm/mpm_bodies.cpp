@@ -138,6 +138,7 @@ long long MpmBodies<dim>::rebalance() {
   const double mean = static_cast<double>(n_total_) / comm_->getSize();
   imbalance_ = mean > 0 ? largest / mean : 1.0;
   const double above = setup_.rebalance_above;
+  if (imbalance_ <= above) retry_above_ = 0.0;  // balanced again: the next excess may be splittable
   if (!(above > 0) || imbalance_ <= above || imbalance_ <= retry_above_) return 0;
   long long new_largest = 0;
   ParticleSlabs<dim> s = rebalanced_slabs(setup_.particles, slabs_, setup_.grid, *comm_, new_largest);

@@ -170,21 +170,24 @@ ParticleSlabs<dim> rebalanced_slabs(const Particles<dim>& p, const ParticleSlabs
   const int axis = old.axis, nranks = comm.getSize();
   const int layers = std::max(grid.n_cells[axis], 1);
   const double o = grid.origin(axis), dx = grid.dx;
-  Kokkos::View<long long*, MemSpace> hist("mpm_slab_histogram", layers);
+  // Bin 0: below the grid; bins 1..layers: the cell layers; bin layers + 1:
+  // above the grid (particles not yet inside an extended grid).
+  Kokkos::View<long long*, MemSpace> hist("mpm_slab_histogram", layers + 2);
   const auto x = p.x;
   Kokkos::parallel_for(
       "mpm_slab_histogram", Kokkos::RangePolicy<ExecSpace>(0, p.size()), KOKKOS_LAMBDA(const LO q) {
         const double c = std::floor((x(q, axis) - o) / dx);
-        const int k = !(c > 0.0) ? 0 : c >= layers - 1 ? layers - 1 : static_cast<int>(c);
+        const int k = !(c >= 0.0) ? 0 : c >= layers ? layers + 1 : 1 + static_cast<int>(c);  // NaN: bin 0
         Kokkos::atomic_add(&hist(k), 1LL);
       });
   auto h = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), hist);
-  std::vector<long long> mine(h.data(), h.data() + layers), all(layers, 0);
-  Teuchos::reduceAll(comm, Teuchos::REDUCE_SUM, layers, mine.data(), all.data());
-  // below[k]: particles under face k (layers 0..k-1).
-  std::vector<long long> below(layers + 1, 0);
-  for (int k = 0; k < layers; ++k) below[k + 1] = below[k] + all[k];
-  const double total = static_cast<double>(below[layers]);
+  std::vector<long long> mine(h.data(), h.data() + layers + 2), all(layers + 2, 0);
+  Teuchos::reduceAll(comm, Teuchos::REDUCE_SUM, layers + 2, mine.data(), all.data());
+  // below[f]: particles under face f (coordinate o + f dx), f = 0..layers.
+  std::vector<long long> below(layers + 1, all[0]);
+  for (int k = 0; k < layers; ++k) below[k + 1] = below[k] + all[k + 1];
+  const long long n_all = below[layers] + all[layers + 1];
+  const double total = static_cast<double>(n_all);
   ParticleSlabs<dim> s;
   s.axis = axis;
   s.nranks = nranks;
@@ -202,7 +205,7 @@ ParticleSlabs<dim> rebalanced_slabs(const Particles<dim>& p, const ParticleSlabs
     largest = std::max(largest, below[face] - prev);
     prev = below[face];
   }
-  largest = std::max(largest, below[layers] - prev);
+  largest = std::max(largest, n_all - prev);
   Kokkos::deep_copy(s.cuts, ch);
   return s;
 }

@@ -47,9 +47,10 @@ ParticleSlabs<dim> balanced_slabs(const Particles<dim>& all, const GridSpec<dim>
 // Cuts along old.axis at cell faces that split the particles of all ranks
 // (p: this rank's) into slabs of about equal counts, from the particle count
 // of every cell layer summed over the ranks (collective: one sum of
-// grid.n_cells[axis] counts; particles outside the grid count in the first or
-// last layer). largest: the most particles a new slab holds. Work O(particles
-// / ranks + layers); for a rebalance, not for every step.
+// grid.n_cells[axis] + 2 counts; particles below or above the grid, not yet
+// in an extended grid, have a bin each: they stay on the first or last slab).
+// largest: the most particles a new slab holds. Work O(particles / ranks +
+// layers); for a rebalance, not for every step.
 template <int dim>
 ParticleSlabs<dim> rebalanced_slabs(const Particles<dim>& p, const ParticleSlabs<dim>& old, const GridSpec<dim>& grid,
                                     const Teuchos::Comm<int>& comm, long long& largest);

@@ -3,6 +3,7 @@
 #include <Tpetra_CrsMatrix.hpp>
 #include <Tpetra_Export.hpp>
 #include <algorithm>
+#include <limits>
 #include <stdexcept>
 #include <string>
 
@@ -39,15 +40,21 @@ HostCrs host_crs(const Matrix& A) {
   return {rows, c};
 }
 
-// Offset in A's values of (owned row r, A column c); A's rows are sorted.
-LO offset_of(const HostCrs& a, LO r, LO c, GO grow, GO gcol) {
-  const LO* b = a.cols.data() + a.rows(r);
-  const LO* e = a.cols.data() + a.rows(r + 1);
-  const LO* it = std::lower_bound(b, e, c);
-  if (c < 0 || it == e || *it != c)
-    throw std::logic_error("OverlapMatrixSum: entry (" + std::to_string(grow) + ", " + std::to_string(gcol) +
-                           ") of an overlap matrix is not in the owned graph");
-  return static_cast<LO>(it - a.cols.data());
+// Offset in A's values of (owned row r, A column c); A's rows are sorted
+// (fillComplete sorts them). A missing entry is recorded in `error` (the
+// first one) and gives 0: the plan's collectives run to the end on every
+// rank, then every rank throws together.
+LO offset_of(const HostCrs& a, LO r, LO c, GO grow, GO gcol, std::string& error) {
+  if (r != Teuchos::OrdinalTraits<LO>::invalid()) {
+    const LO* b = a.cols.data() + a.rows(r);
+    const LO* e = a.cols.data() + a.rows(r + 1);
+    const LO* it = std::lower_bound(b, e, c);
+    if (c >= 0 && it != e && *it == c) return static_cast<LO>(it - a.cols.data());
+  }
+  if (error.empty())
+    error = "OverlapMatrixSum: entry (" + std::to_string(grow) + ", " + std::to_string(gcol) +
+            ") of an overlap matrix is not in the owned graph of its row's owner";
+  return 0;
 }
 
 }  // namespace
@@ -63,6 +70,7 @@ OverlapMatrixSum::OverlapMatrixSum(const Matrix& A_ov, const Matrix& A, const Tp
   const HostCrs ov = host_crs(A_ov), a = host_crs(A);
   const LO invalid = Teuchos::OrdinalTraits<LO>::invalid();
   const LO n_ov = static_cast<LO>(row_ov.getNodeNumElements());
+  std::string error;
 
   // Owned rows: each entry to its offset in A.
   std::vector<LO> lsrc, ldst;
@@ -73,7 +81,7 @@ OverlapMatrixSum::OverlapMatrixSum(const Matrix& A_ov, const Matrix& A, const Tp
     for (std::size_t k = ov.rows(i); k < ov.rows(i + 1); ++k) {
       const GO gcol = col_ov.getGlobalElement(ov.cols(k));
       lsrc.push_back(static_cast<LO>(k));
-      ldst.push_back(offset_of(a, r, col.getLocalElement(gcol), grow, gcol));
+      ldst.push_back(offset_of(a, r, col.getLocalElement(gcol), grow, gcol, error));
     }
   }
   local_src_ = to_device(lsrc, "overlap_sum_local_src");
@@ -95,7 +103,11 @@ OverlapMatrixSum::OverlapMatrixSum(const Matrix& A_ov, const Matrix& A, const Tp
     }
   }
   std::vector<int> scount(nranks), rcount(nranks), sdisp(nranks + 1, 0), rdisp(nranks + 1, 0);
-  for (int p = 0; p < nranks; ++p) scount[p] = static_cast<int>(src[p].size());
+  for (int p = 0; p < nranks; ++p) {
+    if (src[p].size() > static_cast<std::size_t>(std::numeric_limits<int>::max() / 2))
+      error = "OverlapMatrixSum: more than 2^30 values for one rank (MPI counts are int)";
+    scount[p] = static_cast<int>(std::min(src[p].size(), static_cast<std::size_t>(std::numeric_limits<int>::max() / 2)));
+  }
   MPI_Alltoall(scount.data(), 1, MPI_INT, rcount.data(), 1, MPI_INT, comm_);
   std::vector<LO> ssrc;
   std::vector<long long> skeys;
@@ -126,11 +138,11 @@ OverlapMatrixSum::OverlapMatrixSum(const Matrix& A_ov, const Matrix& A, const Tp
   std::vector<LO> rdst(rkeys.size() / 2);
   for (std::size_t m = 0; m < rdst.size(); ++m) {
     const GO grow = rkeys[2 * m], gcol = rkeys[2 * m + 1];
-    const LO r = row.getLocalElement(grow);
-    if (r == invalid)
-      throw std::logic_error("OverlapMatrixSum: received row " + std::to_string(grow) + " that this rank does not own");
-    rdst[m] = offset_of(a, r, col.getLocalElement(gcol), grow, gcol);
+    rdst[m] = offset_of(a, row.getLocalElement(grow), col.getLocalElement(gcol), grow, gcol, error);
   }
+  int bad = error.empty() ? 0 : 1, any = 0;
+  MPI_Allreduce(&bad, &any, 1, MPI_INT, MPI_MAX, comm_);
+  if (any) throw std::logic_error(bad ? error : "OverlapMatrixSum: an entry missing from the owned graph on another rank");
   send_src_ = to_device(ssrc, "overlap_sum_send_src");
   recv_dst_ = to_device(rdst, "overlap_sum_recv_dst");
   send_buf_ = Kokkos::View<double*, MemSpace>("overlap_sum_send", ssrc.size());

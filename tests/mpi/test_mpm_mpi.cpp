@@ -324,3 +324,46 @@ TEST(MpmMpi, SlabsRebalanceWhenParticlesCrowdOneRank) {
                 << d.worst_imbalance << ", at the end " << dist.mpm()->imbalance() << "\n";
   }
 }
+
+// rebalanced_slabs on a known histogram: grid covering [0, 1]^2, dx 0.1
+// (faces -0.1 .. 1.1 along x); of 20 particles, 6 lie below the grid
+// (x = -0.5), 4 inside (x = 0.25) and 10 above it (x = 1.5), spread over the
+// ranks by index. On 2 ranks the cut that
+// halves them is the grid's top face (10 below it, 10 above), the largest
+// slab 10, on every rank alike; particles outside the grid are counted on
+// their own side of the faces.
+TEST(MpmMpi, RebalancedCutsCountParticlesOutsideTheGridOnTheirSide) {
+  auto world = Tpetra::getDefaultComm();
+  const int me = world->getRank(), n = world->getSize();
+  const GridSpec<2> grid = grid_covering<2>(Vec<2>(0.0, 0.0), Vec<2>(1.0, 1.0), 0.1);
+  std::vector<double> xs;
+  for (int q = 0; q < 20; ++q)
+    if (q % n == me) xs.push_back(q < 6 ? -0.5 : q < 10 ? 0.25 : 1.5);
+  Particles<2> p = allocate_particles<2>(xs.size());
+  auto xh = Kokkos::create_mirror_view(p.x);
+  for (std::size_t q = 0; q < xs.size(); ++q) {
+    xh(q, 0) = xs[q];
+    xh(q, 1) = 0.5;
+  }
+  Kokkos::deep_copy(p.x, xh);
+  ParticleSlabs<2> old;
+  old.axis = 0;
+  old.nranks = n;
+  long long largest = 0;
+  const ParticleSlabs<2> s = rebalanced_slabs<2>(p, old, grid, *world, largest);
+  auto cuts = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), s.cuts);
+  ASSERT_EQ(static_cast<int>(cuts.extent(0)), n - 1);
+  if (n == 1) {
+    EXPECT_EQ(largest, 20);
+  } else if (n == 2) {
+    EXPECT_NEAR(cuts(0), grid.origin(0) + grid.n_cells[0] * grid.dx, 1e-12);
+    EXPECT_EQ(largest, 10);
+  }
+  for (std::size_t k = 0; k + 1 < cuts.extent(0); ++k) EXPECT_LE(cuts(k), cuts(k + 1));
+  std::vector<double> mine(cuts.data(), cuts.data() + cuts.extent(0)), lo(mine.size() + 1), hi(mine.size() + 1);
+  mine.push_back(static_cast<double>(largest));
+  const int k = static_cast<int>(mine.size());
+  Teuchos::reduceAll(*world, Teuchos::REDUCE_MIN, k, mine.data(), lo.data());
+  Teuchos::reduceAll(*world, Teuchos::REDUCE_MAX, k, mine.data(), hi.data());
+  EXPECT_EQ(lo, hi) << "the ranks computed different cuts";
+}
