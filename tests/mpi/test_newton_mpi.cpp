@@ -95,18 +95,37 @@ Teuchos::ParameterList cg_list(const std::string& prec) {
   return ls;
 }
 
+// The FEM block of element size h, its bottom nodes (flags) and the identity
+// numbering of its nodes (the whole block on one rank).
+template <int dim>
+struct Block {
+  FemMesh<dim> mesh;
+  std::vector<char> bottom;
+  std::vector<GO> all;
+};
+
+template <int dim>
+Block<dim> make_block(double h) {
+  auto setup = fixtures::block_setup<dim>(h);
+  Block<dim> b{build_fem_mesh<dim>(setup.bodies, setup.materials), {}, {}};
+  const LO nn = b.mesh.num_nodes();
+  b.bottom.assign(nn, 0);
+  for (long long v : setup.bodies[0].mesh.node_sets.at("bottom")) b.bottom[v] = 1;
+  b.all.resize(nn);
+  for (LO a = 0; a < nn; ++a) b.all[a] = a;
+  return b;
+}
+
 template <int dim>
 void distributed_equals_serial(const std::string& prec, double h) {
   auto comm = Tpetra::getDefaultComm();
-  auto setup = fixtures::block_setup<dim>(h);
-  const FemMesh<dim> mesh = build_fem_mesh<dim>(setup.bodies, setup.materials);
+  const Block<dim> block = make_block<dim>(h);
+  const FemMesh<dim>& mesh = block.mesh;
+  const std::vector<char>& bottom = block.bottom;
+  const std::vector<GO>& all = block.all;
   const LO nn = mesh.num_nodes();
-  std::vector<char> bottom(nn, 0);
-  for (long long v : setup.bodies[0].mesh.node_sets.at("bottom")) bottom[v] = 1;
 
   // Reference: the whole block on this rank alone, Cholmod.
-  std::vector<GO> all(nn);
-  for (LO a = 0; a < nn; ++a) all[a] = a;
   Problem<dim> ref = make_problem<dim>(mesh, all, bottom);
   Teuchos::ParameterList direct = *linear_solver_schema();
   const NewtonStats st_ref = minimize<dim>(mesh, ref, Teuchos::rcp(new Teuchos::SerialComm<int>()), direct, nullptr);
@@ -211,14 +230,11 @@ RowSystem assemble_rows(const FemMesh<dim>& mesh, const std::vector<GO>& global_
 template <int dim>
 void distributed_system_equals_serial(double h) {
   auto comm = Tpetra::getDefaultComm();
-  auto setup = fixtures::block_setup<dim>(h);
-  const FemMesh<dim> mesh = build_fem_mesh<dim>(setup.bodies, setup.materials);
+  const Block<dim> block = make_block<dim>(h);
+  const FemMesh<dim>& mesh = block.mesh;
+  const std::vector<char>& bottom = block.bottom;
   const LO nn = mesh.num_nodes();
-  std::vector<char> bottom(nn, 0);
-  for (long long v : setup.bodies[0].mesh.node_sets.at("bottom")) bottom[v] = 1;
-  std::vector<GO> all(nn);
-  for (LO a = 0; a < nn; ++a) all[a] = a;
-  const RowSystem ref = assemble_rows<dim>(mesh, all, nn, bottom, Teuchos::rcp(new Teuchos::SerialComm<int>()), false, 1);
+  const RowSystem ref = assemble_rows<dim>(mesh, block.all, nn, bottom, Teuchos::rcp(new Teuchos::SerialComm<int>()), false, 1);
   const FemPartition part = partition_fem_mesh<dim>(mesh, comm);
   const FemMesh<dim> local = local_fem_mesh<dim>(mesh, part);
   for (int assemblies : {1, 3}) {
@@ -290,7 +306,9 @@ TEST(NewtonMpi, PartitionCoversEveryNodeAndElementOnce) {
     int most = 0;
     Teuchos::reduceAll(*comm, Teuchos::REDUCE_MAX, ghosts, Teuchos::outArg(most));
     EXPECT_GT(most, 0) << "no ghost nodes on a cut mesh";
-    if (comm->getRank() == 0) EXPECT_EQ(ghosts, 0);
+    if (comm->getRank() == 0) {
+      EXPECT_EQ(ghosts, 0);
+    }
   }
 }
 
