@@ -7,7 +7,8 @@
 # the mean per contact step of step_s, assembly_s, solve_s and the Newton
 # iterations from each run's diagnostics.csv, plus graph builds and the peak
 # resident memory, as JSON that perf/compare.py reads:
-#   perf/run_scenes.sh [--build-dir DIR] [--out FILE] [--threads "1 2"] [--steps N]
+#   perf/run_scenes.sh [--build-dir DIR] [--out FILE] [--threads "1 2"] [--steps N] [--set KEY=VALUE ...]
+# (--set: passed on to bfemp, e.g. an A/B of a Newton or linear-solver key on one binary)
 #   python3 perf/compare.py build/perf/scenes.json --baseline perf/baselines/scenes.json \
 #       --fields step_s,assembly_s,solve_s
 # Goal (speed issue): <= 0.25 s per contact step at 2 threads.
@@ -17,13 +18,15 @@ build_dir="$repo/build"
 out=""
 threads="1 2"
 steps=50
+extra=()
 while [[ $# -gt 0 ]]; do
   case "$1" in
     --build-dir) build_dir="$(cd "$2" && pwd)"; shift 2 ;;
     --out) out="$2"; shift 2 ;;
     --threads) threads="$2"; shift 2 ;;
     --steps) steps="$2"; shift 2 ;;
-    -h|--help) sed -n '2,15p' "${BASH_SOURCE[0]}"; exit 0 ;;
+    --set) extra+=(--set "$2"); shift 2 ;;
+    -h|--help) sed -n '2,16p' "${BASH_SOURCE[0]}"; exit 0 ;;
     *) echo "run_scenes.sh: unknown argument '$1' (see --help)" >&2; exit 2 ;;
   esac
 done
@@ -43,7 +46,7 @@ for t in $threads; do
     --set "FEM Bodies/right/Mesh/element size=0.13" \
     --set "MPM Bodies/left/center=[-4.01, 0.0]" --set "FEM Bodies/right/Mesh/center=[4.01, 0.0]" \
     --set "Time/dt=2.0e-4" --set "Time/end time=$end_time" \
-    --set "Output/frame every=1000000" --set "Output/progress every=10" > "$tmp/log$t" 2>&1 \
+    --set "Output/frame every=1000000" --set "Output/progress every=10" ${extra[@]+"${extra[@]}"} > "$tmp/log$t" 2>&1 \
     || { cat "$tmp/log$t" >&2; echo "run_scenes.sh: the run failed at $t thread(s)" >&2; exit 1; }
   grep -E "^(FEM|energy terms)|graph builds|assembly time|^    " "$tmp/log$t" || true
   runs+=("$t:$tmp/rings$t/diagnostics.csv:$tmp/mem$t:$tmp/log$t")

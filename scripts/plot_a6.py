@@ -11,7 +11,7 @@ runs ahead of the plate. The onset is taken where the crown's lead over the
 plate first exceeds 0.15 m (the gaps the plate closes before pressing are
 about 0.05-0.09 m of lag).
 
-usage: plot_a6.py OUT.png MU=DIR [MU=DIR ...]   (needs h5py, numpy, matplotlib)
+usage: plot_a6.py OUT.png MU=DIR [MU=DIR ...] [--title TEXT]   (needs h5py, numpy, matplotlib)
 """
 import sys
 
@@ -38,7 +38,13 @@ def crown_lead(path):
 
 
 def main():
-    out, runs = sys.argv[1], [a.split("=", 1) for a in sys.argv[2:]]
+    args = sys.argv[1:]
+    title = ""
+    if "--title" in args:
+        k = args.index("--title")
+        title = args[k + 1]
+        del args[k:k + 2]
+    out, runs = args[0], [a.split("=", 1) for a in args[1:]]
     fig, ax = plt.subplots(figsize=(6, 4))
     for mu, d in runs:
         t, lead = crown_lead(d)
@@ -50,7 +56,7 @@ def main():
     ax.axhline(0.15, color="grey", lw=0.8, ls="--")
     ax.set_xlabel("plate travel (m)")
     ax.set_ylabel("inner crown travel beyond the plate (m)")
-    ax.set_title("A6: inner semi-ring buckling vs friction (ci size)")
+    ax.set_title("A6: inner semi-ring buckling vs friction" + (f" ({title})" if title else ""))
     ax.legend()
     fig.tight_layout()
     fig.savefig(out, dpi=120)

@@ -4,11 +4,12 @@ scenes with `bfemp run`, measures each band with `bfemp probe` (the probes the
 tests use), and writes OUT/report.md (one row per band) with a PNG per scene
 drawn from the runs' own diagnostics.csv.
 
-    validate.py [--size ci|paper] [--scenes A1,A2,A3,A4] [--out DIR] [--bfemp PATH]
+    validate.py [--size ci|paper] [--scenes A1,A2,A3,A4,A6] [--out DIR] [--bfemp PATH]
 
 Scenes: A1 rings (APIC, FLIP), A2 sine press (BFEMP and the level-set
 boundary), A3 Brazilian disk (linear, neo-Hookean), A4 box on a slope (mu = 0,
-0.1, 0.1999, 0.2). A5 (refinement) is a sweep: scripts/run_sweeps.sh --only a5. Each run goes into OUT/<run>/
+0.1, 0.1999, 0.2), A6 semicircular rings (mu = 0, 0.2, 0.5; the crown's
+buckling onset, read from the frames). A5 (refinement) is a sweep: scripts/run_sweeps.sh --only a5. Each run goes into OUT/<run>/
 (bfemp.xdmf for ParaView, diagnostics.csv, log.txt). Threads: OMP_NUM_THREADS
 (default 2). Exit status 0 when every band that applies passes, 1 otherwise.
 Plots need matplotlib (Debian's python3-matplotlib); without it the report
@@ -117,6 +118,28 @@ def scenes(size):
     s["A4"]["bands"].append(
         ("A4_mu0.2", "max sliding speed / eps_v", "max_speed:body=box,axis=x," + a4_window, "O(1)",
          lambda v: v < 10, "< 10", 1e-5))
+    # A6: the inner ring's crown (particles with |x| < 1, y > 9.5 at t = 0)
+    # against the plate's travel (1 m/s down); onset = the first frame where
+    # it leads the plate by 0.15 m (scripts/plot_a6.py draws the curves).
+    a6_crown = "lead_onset:box_min=-1;9.5,box_max=1;12,speed=-1,threshold=0.15"
+    a6_end = "8.0"
+    s["A6"] = {
+        "title": "A6 semicircular rings buckling under friction (section 6.6, Fig. 15)",
+        "runs": [("A6_mu%s" % mu, scene_path(size, "a6_semiring_buckling.yaml"),
+                  ["Time/end time=" + a6_end, "Contact/Friction Pairs/inner : outer=%s" % mu])
+                 for mu in ("0", "0.2", "0.5")],
+        "bands": [
+            ("A6_mu0", "buckling onset, plate travel (m)", a6_crown, "buckles first",
+             lambda v, on: v == v, "buckles"),
+            ("A6_mu0.2", "buckling onset, plate travel (m)", a6_crown, "later than mu 0",
+             lambda v, on: v == v and on.get("A6_mu0", float("nan")) < v, "> mu 0's"),
+            ("A6_mu0.5", "buckling onset, plate travel (m)", a6_crown, "none",
+             lambda v, on: v != v, "none within %s m" % a6_end),
+        ],
+        "plot_dirs": plot_a6,
+        "notes": {"ci": ["at dx = 0.5 the inner ring is 4 cells thick; with mu = 0.5 it still buckles (later and "
+                         "more slowly than with 0.2), where the paper shows no buckling (validation/a6/README.md)"]},
+    }
     return s
 
 
@@ -215,6 +238,13 @@ def plot_a4(plt, out, runs):
                out)
 
 
+def plot_a6(plt, out, dirs):
+    # The crown curves read the runs' frames (h5py): scripts/plot_a6.py.
+    subprocess.run([sys.executable, os.path.join(REPO, "scripts", "plot_a6.py"), out] +
+                   ["%s=%s" % (name.split("_mu")[1], d) for name, d in dirs.items()], check=True,
+                   stdout=subprocess.DEVNULL)
+
+
 def git_rev():
     try:
         return subprocess.run(["git", "-C", REPO, "describe", "--always", "--dirty"], capture_output=True,
@@ -226,7 +256,7 @@ def git_rev():
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--size", choices=["ci", "paper"], default="ci")
-    ap.add_argument("--scenes", default="A1,A2,A3,A4")
+    ap.add_argument("--scenes", default="A1,A2,A3,A4,A6")
     ap.add_argument("--out", default="validation-out")
     ap.add_argument("--bfemp", default=os.path.join(REPO, "build", "drivers", "bfemp"))
     ap.add_argument("--reuse", action="store_true",
@@ -272,6 +302,7 @@ def main():
             results[run] = {"rc": rc, "wall": wall, "dir": d}
             csvp = os.path.join(d, "diagnostics.csv")
             results[run]["data"] = read_csv(csvp) if os.path.exists(csvp) else {}
+        measured = {}  # run -> value of this scene's bands so far (checks that compare runs)
         for band in sc["bands"]:
             run, measure, spec, paper, check, band_text = band[:6]
             scale = band[6] if len(band) > 6 else 1.0
@@ -284,7 +315,13 @@ def main():
                 try:
                     value = probe(args.bfemp, r["dir"], spec) / scale
                     shown = "%.9g" % value
-                    ok = None if check is None else (value == value and bool(check(value)))
+                    if check is None:
+                        ok = None
+                    elif check.__code__.co_argcount == 2:  # may judge a NaN (never) or compare runs
+                        ok = bool(check(value, measured))
+                    else:
+                        ok = value == value and bool(check(value))
+                    measured[run] = value
                 except RuntimeError as e:
                     value, ok, shown = float("nan"), False, "probe failed: %s" % e
             if ok is False:
@@ -297,9 +334,12 @@ def main():
         if plt is not None:
             png = os.path.join(args.out, name + ".png")
             try:
-                sc["plot"](plt, png, {k: v["data"] for k, v in results.items() if v["data"]})
+                if "plot_dirs" in sc:
+                    sc["plot_dirs"](plt, png, {k: v["dir"] for k, v in results.items() if v["rc"] == 0})
+                else:
+                    sc["plot"](plt, png, {k: v["data"] for k, v in results.items() if v["data"]})
                 notes.append("![%s](%s.png)" % (sc["title"], name))
-            except (KeyError, ValueError, IndexError) as e:
+            except (KeyError, ValueError, IndexError, subprocess.CalledProcessError) as e:
                 notes.append("%s: no plot (%s)" % (name, e))
         else:
             notes.append("%s: no plot (matplotlib missing: install python3-matplotlib)" % name)

@@ -419,6 +419,8 @@ SimulationSetup<dim> build_setup(const Scene& scene) {
   setup.newton.hessian = p.sublist("Newton").get<std::string>("hessian") == "exact-if-definite"
                              ? HessianMode::ExactIfDefinite
                              : HessianMode::Projected;
+  setup.newton.line_search = p.sublist("Newton").get<std::string>("line search") == "wolfe" ? LineSearch::Wolfe
+                                                                                              : LineSearch::Backtracking;
   setup.newton.log_iterations = p.sublist("Newton").get<bool>("log iterations");
   setup.linear_solver = p.sublist("Linear Solver");
   return setup;
@@ -454,7 +456,7 @@ std::string scene_summary(const Scene& scene) {
                   p.sublist("Linear Solver").get<std::string>("type") != "Cholmod"
               ? "projected Hessian"
               : "exact Hessian where definite")
-      << "\n";
+      << ", line search " << p.sublist("Newton").get<std::string>("line search") << "\n";
   }
   const auto& bodies = p.sublist("FEM Bodies");
   for (auto it = bodies.begin(); it != bodies.end(); ++it) {

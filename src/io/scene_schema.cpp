@@ -162,6 +162,11 @@ Teuchos::RCP<const ParameterList> scene_schema() {
          "(other linear solvers: always projected); projected: PSD-projected stencil Hessians (paper "
          "Algorithm 2)",
          tuple<std::string>("projected", "exact-if-definite"));
+  choice(newton, "line search", "wolfe",
+         "wolfe: when the first step raises the energy, bisect on the sign of the directional derivative "
+         "(strong Wolfe, c2 0.1) before halving; it lands in a friction stick zone that halving steps over. "
+         "backtracking: halving only (the paper's)",
+         tuple<std::string>("wolfe", "backtracking"));
   newton.set("log iterations", false,
              "print one line per Newton iteration to stderr: |p|_inf/dt, line-search step and its CCD/inversion "
              "bound, |rhs|, which Hessian");

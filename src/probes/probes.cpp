@@ -242,16 +242,40 @@ double equilibrium_height(const RunTable& t, const std::vector<std::string>& bod
   return M > 0 ? mx / M : kNaN;
 }
 
+namespace {
+
+std::string frame_group(int k) {
+  char b[32];
+  std::snprintf(b, sizeof b, "/frame_%06d", k);
+  return std::string(b);
+}
+
+// Number of frames with particle positions in a run's bfemp.h5 (> 0).
+int particle_frames(const std::string& h5, const std::string& probe) {
+  int frames = 0;
+  while (dataset_exists(h5, frame_group(frames) + "/particle_positions")) ++frames;
+  if (frames == 0) throw std::invalid_argument("probe " + probe + ": no particle frames in '" + h5 + "'");
+  return frames;
+}
+
+// Particles inside [lo, hi] (x, dim components each) at frame 0.
+std::vector<std::size_t> particles_in_box(const std::vector<double>& x0, std::size_t dim, const std::vector<double>& lo,
+                                          const std::vector<double>& hi) {
+  std::vector<std::size_t> sel;
+  for (std::size_t q = 0; q < x0.size() / dim; ++q) {
+    bool in = true;
+    for (std::size_t c = 0; c < dim; ++c) in = in && x0[q * dim + c] >= lo[c] && x0[q * dim + c] <= hi[c];
+    if (in) sel.push_back(q);
+  }
+  return sel;
+}
+
+}  // namespace
+
 double rotation(const std::string& h5, const std::vector<double>& lo, const std::vector<double>& hi,
                 const std::vector<double>& center, int axis, double time) {
-  auto frame = [](int k) {
-    char b[32];
-    std::snprintf(b, sizeof b, "/frame_%06d", k);
-    return std::string(b);
-  };
-  int frames = 0;
-  while (dataset_exists(h5, frame(frames) + "/particle_positions")) ++frames;
-  if (frames == 0) throw std::invalid_argument("probe rotation: no particle frames in '" + h5 + "'");
+  const auto frame = frame_group;
+  const int frames = particle_frames(h5, "rotation");
   int pick = frames - 1;
   if (std::isfinite(time)) {
     double best = kInf;
@@ -271,10 +295,7 @@ double rotation(const std::string& h5, const std::vector<double>& lo, const std:
   const int i = (axis + 1) % 3, j = (axis + 2) % 3;  // the plane of the rotation
   double sum = 0;
   long n = 0;
-  for (std::size_t q = 0; q < x0.size() / dim; ++q) {
-    bool in = true;
-    for (std::size_t c = 0; c < dim; ++c) in = in && x0[q * dim + c] >= lo[c] && x0[q * dim + c] <= hi[c];
-    if (!in) continue;
+  for (const std::size_t q : particles_in_box(x0, dim, lo, hi)) {
     const double a0 = x0[q * dim + i] - center[i], b0 = x0[q * dim + j] - center[j];
     const double a1 = x1[q * dim + i] - center[i], b1 = x1[q * dim + j] - center[j];
     if (a0 * a0 + b0 * b0 < 1e-24) continue;  // on the axis: no angle
@@ -285,6 +306,32 @@ double rotation(const std::string& h5, const std::vector<double>& lo, const std:
   return sum / double(n);
 }
 
+double lead_onset(const std::string& h5, const std::vector<double>& lo, const std::vector<double>& hi, int axis,
+                  double speed, double threshold) {
+  if (!(speed != 0) || !std::isfinite(speed))
+    throw std::invalid_argument("probe lead_onset: speed = " + std::to_string(speed) + ", expected a nonzero number");
+  const int frames = particle_frames(h5, "lead_onset");
+  std::vector<std::size_t> shape;
+  const std::vector<double> x0 = read_dataset(h5, frame_group(0) + "/particle_positions", &shape);
+  const std::size_t dim = shape.size() > 1 ? shape[1] : 1;
+  if (lo.size() != dim || hi.size() != dim)
+    throw std::invalid_argument("probe lead_onset: box_min and box_max need " + std::to_string(dim) +
+                                " components (x;y" + std::string(dim == 3 ? ";z" : "") + ")");
+  if (axis >= int(dim)) throw std::invalid_argument("probe lead_onset: axis z in a 2D run");
+  const std::vector<std::size_t> sel = particles_in_box(x0, dim, lo, hi);
+  if (sel.empty()) throw std::invalid_argument("probe lead_onset: no particle inside [box_min, box_max] at frame 0");
+  const double sign = speed > 0 ? 1.0 : -1.0;
+  for (int k = 1; k < frames; ++k) {
+    const std::vector<double> x = read_dataset(h5, frame_group(k) + "/particle_positions", nullptr);
+    double u = 0;
+    for (const std::size_t q : sel) u += x[q * dim + axis] - x0[q * dim + axis];
+    u /= double(sel.size());
+    const double t = read_attribute(h5, frame_group(k), "time");
+    if (sign * (u - speed * t) > threshold) return t;
+  }
+  return kNaN;
+}
+
 }  // namespace probe
 
 // ---- the registry ------------------------------------------------------------
@@ -292,6 +339,26 @@ double rotation(const std::string& h5, const std::vector<double>& lo, const std:
 namespace {
 
 double from_of(const ProbeArgs& a) { return a.number("from", -kInf); }
+
+// A vector argument "x;y[;z]".
+std::vector<double> vector_arg(const ProbeArgs& a, const std::string& key) {
+  std::vector<double> v;
+  std::stringstream ss(a.text(key));
+  std::string item;
+  while (std::getline(ss, item, ';')) {
+    char* end = nullptr;
+    v.push_back(std::strtod(item.c_str(), &end));
+    if (end == item.c_str() || *end != '\0') bad_arg(a.name, key, a.text(key), "numbers joined by ';'");
+  }
+  return v;
+}
+
+// The run's bfemp.h5, for probes that read its frames.
+std::string frames_file(const RunTable& t, const ProbeArgs& a) {
+  if (t.source_dir().empty())
+    throw std::invalid_argument("probe '" + a.name + "' reads a run's frames: evaluate it on a run directory");
+  return t.source_dir() + "/bfemp.h5";
+}
 double to_of(const ProbeArgs& a) { return a.number("to", kInf); }
 double t_of(const ProbeArgs& a) { return a.number("t", kNaN); }
 
@@ -385,21 +452,16 @@ const std::vector<ProbeInfo>& probe_list() {
        "mean rotation angle about the axis of the particles in the box at frame 0, at the frame nearest t "
        "(rad; reads the run's bfemp.h5)",
        [](const RunTable& t, const ProbeArgs& a) {
-         if (t.source_dir().empty())
-           throw std::invalid_argument("probe 'rotation' reads a run's frames: evaluate it on a run directory");
-         auto vec = [&](const std::string& key) {
-           std::vector<double> v;
-           std::stringstream ss(a.text(key));
-           std::string item;
-           while (std::getline(ss, item, ';')) {
-             char* end = nullptr;
-             v.push_back(std::strtod(item.c_str(), &end));
-             if (end == item.c_str() || *end != '\0') bad_arg(a.name, key, a.text(key), "numbers joined by ';'");
-           }
-           return v;
-         };
-         return probe::rotation(t.source_dir() + "/bfemp.h5", vec("box_min"), vec("box_max"), vec("center"),
-                                a.axis("axis", 2), t_of(a));
+         auto vec = [&](const std::string& key) { return vector_arg(a, key); };
+         return probe::rotation(frames_file(t, a), vec("box_min"), vec("box_max"), vec("center"), a.axis("axis", 2),
+                                t_of(a));
+       }},
+      {"lead_onset", "box_min=X;Y[;Z],box_max=X;Y[;Z],speed=V[,axis=y][,threshold=D]",
+       "first frame time at which the particles in the box at frame 0 lead a travel speed*t along the axis by "
+       "more than D (default 0.15 m) (s; NaN: never; reads the run's bfemp.h5); A6's buckling onset",
+       [](const RunTable& t, const ProbeArgs& a) {
+         return probe::lead_onset(frames_file(t, a), vector_arg(a, "box_min"), vector_arg(a, "box_max"),
+                                  a.axis("axis", 1), a.number("speed"), a.number("threshold", 0.15));
        }},
       {"value", "column=NAME[,t=T]", "a diagnostics column at t",
        [](const RunTable& t, const ProbeArgs& a) { return t.column(a.text("column"))[probe::row_at(t, t_of(a))]; }},

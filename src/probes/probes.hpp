@@ -34,6 +34,12 @@
 //                     of the particles inside [box_min, box_max] at frame 0,
 //                     at the output frame nearest t (read from the run's
 //                     bfemp.h5; vectors are written x;y[;z]); A7's twist
+//  lead_onset         first frame time at which the particles inside
+//                     [box_min, box_max] at frame 0 lead a motion at `speed`
+//                     along `axis` (a driven plate: travel = speed t) by more
+//                     than `threshold`: lead = sign(speed) (mean u_axis -
+//                     speed t) (m); NaN: never. A6's buckling onset (the
+//                     inner ring's crown falls away from the plate)
 #include <functional>
 #include <map>
 #include <string>
@@ -92,6 +98,12 @@ double equilibrium_height(const RunTable& t, const std::vector<std::string>& bod
 // run's bfemp.h5. std::invalid_argument when no particle is selected.
 double rotation(const std::string& h5, const std::vector<double>& lo, const std::vector<double>& hi,
                 const std::vector<double>& center, int axis, double time);
+// Time of the first frame whose particles selected in [lo, hi] at frame 0
+// lead the travel speed * t along `axis` by more than `threshold` (above);
+// NaN when no frame does. std::invalid_argument when none is selected or
+// speed is 0.
+double lead_onset(const std::string& h5, const std::vector<double>& lo, const std::vector<double>& hi, int axis,
+                  double speed, double threshold);
 }  // namespace probe
 
 }  // namespace bfemp

@@ -152,6 +152,8 @@ void accumulate(RunSummary& s, const StepReport& r) {
   s.projected_retries += r.newton.projected_retries;
   s.exact_hessian_iterations += r.newton.exact_hessian_iterations;
   s.projection_fallbacks += r.newton.projection_fallbacks;
+  s.wolfe_steps += r.newton.wolfe_steps;
+  s.wolfe_gradients += r.newton.wolfe_gradients;
 }
 
 // The signal any rank received (every rank stops after the same step).
@@ -390,8 +392,11 @@ RunSummary run_scene(const Scene& scene, const std::string& dir, const Teuchos::
   if (s.projected_retries > 0)
     log << "  steps redone        " << s.projected_retries
         << " (Newton failed with the exact Hessian; the projected one converged)\n";
-  log
-      << "  line-search time    " << s.line_search_s << " s\n";
+  log << "  line-search time    " << s.line_search_s << " s";
+  if (s.wolfe_gradients > 0)
+    log << " (" << s.wolfe_steps << " step(s) from the Wolfe bisection, " << s.wolfe_gradients
+        << " gradient evaluations)";
+  log << "\n";
   if (s.contact)
     log << "  contact: broad phase " << s.contact_broad_phase_s << " s, pair evaluation " << s.contact_eval_s
         << " s, CCD " << s.contact_ccd_s << " s (within the times above)\n";

@@ -634,6 +634,8 @@ NewtonStats Simulation<dim>::minimize_with_friction(const IncrementalPotential& 
     total.numeric_factorizations += st.numeric_factorizations;
     total.exact_hessian_iterations += st.exact_hessian_iterations;
     total.projection_fallbacks += st.projection_fallbacks;
+    total.wolfe_steps += st.wolfe_steps;
+    total.wolfe_gradients += st.wolfe_gradients;
     if (iterations > 1 && st.iterations == 1) break;  // converged at the lagged update
     const LO relagged = update();
     if (lagged == 0 && relagged == 0) break;  // no friction pairs before or after

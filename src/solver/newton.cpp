@@ -30,6 +30,7 @@ struct NewtonSolver<dim>::Impl {
   bool modes_stale = true;       // MueLu: the matrix changed since the modes were set
   int solves_since_modes = 0;    // minimisations on the current modes
   View1 grad, rhs, dx_prescribed, dir, trial;
+  View1 trial_grad;  // line search: the potential's gradient at a trial point
   std::map<std::string, double> term_s;  // assembly seconds per term name
 
   Impl(const Teuchos::RCP<const Comm>& c, const Teuchos::ParameterList& ls, NewtonParams np)
@@ -46,6 +47,30 @@ struct NewtonSolver<dim>::Impl {
   double all_min(double v) const { return all(v, Teuchos::REDUCE_MIN); }
   double all_sum(double v) const { return all(v, Teuchos::REDUCE_SUM); }
 
+  // phi'(alpha) = grad E(xt) . p over the free DOFs, xt = x + alpha p, summed
+  // over ranks: each rank's local gradient holds its own stencils' parts, p is
+  // alike at shared DOFs, and the inertia counts at the owner.
+  double directional_derivative(const IncrementalPotential& ip, CView1 xt, CView1 p) {
+    auto g = trial_grad;
+    Kokkos::deep_copy(g, 0.0);
+    for (const auto* t : dofs.terms()) t->gradient(xt, ip.h, g);
+    auto mass = ip.mass;
+    auto xhat = ip.x_hat;
+    auto pres = ip.prescribed;
+    const bool dist = dofs.distributed();
+    const auto own = dofs.owned_mask();
+    double d = 0;
+    Kokkos::parallel_reduce(
+        "newton_directional_derivative", Kokkos::RangePolicy<ExecSpace>(0, xt.extent(0)),
+        KOKKOS_LAMBDA(const LO i, double& acc) {
+          if (pres(i)) return;
+          const double inertia = (!dist || own(i)) ? mass(i) * (xt(i) - xhat(i)) : 0.0;
+          acc += (g(i) + inertia) * p(i);
+        },
+        d);
+    return all_sum(d);
+  }
+
   // Vectors for a new node count (grow only when the count changes).
   void resize_vectors() {
     const std::size_t ndof = dofs.num_dofs();  // local (owned + ghost) DOFs
@@ -57,6 +82,7 @@ struct NewtonSolver<dim>::Impl {
     dx_prescribed = View1("newton_dx_prescribed", ndof);
     dir = View1("newton_dir", ndof);
     trial = View1("newton_trial", ndof);
+    trial_grad = View1("newton_trial_grad", ndof);
   }
 
   void matrix_changed() {
@@ -387,6 +413,7 @@ NewtonStats NewtonSolver<dim>::minimize(const IncrementalPotential& ip, View1 x)
     }
     // Armijo-type backtracking on E while the prescribed DOFs are at their
     // targets; while they still move, E may rise and the filtered step is taken.
+    bool wolfe_ended = false;  // this iteration's step from the Wolfe bisection (log)
     if (pres_left == 0.0 && !converged) {
       const Energy E0 = energy(ip, x);
       const double scale = std::abs(E0.inertia) + std::abs(E0.elastic);
@@ -411,12 +438,46 @@ NewtonStats NewtonSolver<dim>::minimize(const IncrementalPotential& ip, View1 x)
             gp);
         gp = m.all_sum(gp);
       }
-      while (true) {
+      auto move_trial = [&](double a) {
         Kokkos::parallel_for(
             "newton_trial", Kokkos::RangePolicy<ExecSpace>(0, x.extent(0)),
-            KOKKOS_LAMBDA(const LO i) { trial(i) = x(i) + alpha * dir(i); });
+            KOKKOS_LAMBDA(const LO i) { trial(i) = x(i) + a * dir(i); });
+      };
+      bool wolfe = m.params.line_search == LineSearch::Wolfe;
+      while (true) {
+        move_trial(alpha);
         const double E1 = energy(ip, trial).total();
         if (E1 <= E0.total() + tol) break;
+        if (wolfe) {  // once, from alpha_0 (LineSearch)
+          wolfe = false;
+          // Bracket (a, b) with phi'(a) < 0 < phi'(b); bisect on the sign of phi'.
+          auto derivative = [&](double a) {
+            move_trial(a);
+            ++st.wolfe_gradients;
+            return m.directional_derivative(ip, trial, dir);
+          };
+          double a = 0, b = alpha, found = -1;
+          if (derivative(b) > 0) {
+            for (int k = 0; k < 50; ++k) {
+              const double c = 0.5 * (a + b);
+              const double dc = derivative(c);
+              if (std::fabs(dc) <= 0.1 * std::fabs(gp)) {
+                found = c;
+                break;
+              }
+              (dc < 0 ? a : b) = c;
+            }
+          }
+          if (found > 0) {
+            move_trial(found);
+            if (energy(ip, trial).total() <= E0.total() + tol) {
+              alpha = found;
+              ++st.wolfe_steps;
+              wolfe_ended = true;
+              break;
+            }
+          }
+        }
         // Near the minimum the predicted decrease alpha |g.p| falls below what
         // the energy sums resolve; the energy cannot judge the step there, and
         // the (filtered) Newton step is taken.
@@ -438,9 +499,10 @@ NewtonStats NewtonSolver<dim>::minimize(const IncrementalPotential& ip, View1 x)
     st.line_search_s += timer.seconds();
     st.min_step = std::min(st.min_step, alpha);
     if (m.params.log_iterations && m.comm->getRank() == 0)
-      std::fprintf(stderr, "  newton %3d  |p|/dt %.3e m/s  step %.3e  (bound %.3e)  |rhs| %.3e  %s Hessian  linear %d it%s%s\n",
-                   it + 1, p_inf / ip.dt, alpha, 0.9 * a_max, r_norm, project ? "projected" : "exact", ls.iterations,
-                   ls.factorised ? " (factorised)" : "", fallback ? " after a non-positive pivot" : "");
+      std::fprintf(stderr, "  newton %3d  |p|/dt %.3e m/s  step %.3e%s  (bound %.3e)  |rhs| %.3e  %s Hessian  linear %d it%s%s\n",
+                   it + 1, p_inf / ip.dt, alpha, wolfe_ended ? " (Wolfe)" : "", 0.9 * a_max, r_norm,
+                   project ? "projected" : "exact", ls.iterations, ls.factorised ? " (factorised)" : "",
+                   fallback ? " after a non-positive pivot" : "");
     st.iterations = it + 1;
     if (on_iterate) on_iterate(x);
     if (converged) return st;

@@ -3,7 +3,7 @@
 //   E(x) = 1/2 |x - x_hat|_M^2 + h Psi(x),   h = 2 alpha beta dt^2,
 // with PSD-projected element Hessians summed into a Tpetra CrsMatrix on a graph
 // built once, a line search starting at min(1, 0.9 * largest step keeping every
-// det F > 0) followed by backtracking, and the stop test |p|_inf / dt < eps_d.
+// det F > 0) (see LineSearch), and the stop test |p|_inf / dt < eps_d.
 // Prescribed DOFs are driven toward their targets inside the same iterations:
 // their part of p is the remaining offset, so the filter also guards them.
 // Psi is a sum of EnergyTerms (FEM elements, MPM particles, contact); the DOF
@@ -34,10 +34,29 @@ namespace bfemp {
 //     (Cholmod); with another the projected Hessian is used.
 enum class HessianMode { Projected, ExactIfDefinite };
 
+// The line search along p from alpha_0 = min(1, 0.9 * the CCD/inversion bound),
+// phi(alpha) = E(x + alpha p), phi'(0) = grad E . p < 0:
+//   Backtracking: halve alpha until phi(alpha) <= phi(0) (+ the energy sums'
+//     round-off, 1e-13 (|inertia| + |elastic|)).
+//   Wolfe: when phi(alpha_0) > phi(0) and phi'(alpha_0) > 0, first bisect the
+//     bracket (0, alpha_0) on the sign of phi' (one gradient evaluation each)
+//     until |phi'(alpha)| <= 0.1 |phi'(0)| (the strong Wolfe curvature
+//     condition), and take that alpha if phi(alpha) <= phi(0); otherwise (no
+//     sign change, 50 bisections, or the energy rose) backtracking.
+// Why Wolfe: the lagged friction energy mu lambda f0(|u_t|) is a rounded V of
+// width eps_v h about u_t = 0. On the slip side its Hessian has no curvature
+// along a 1D tangent (2D), so the Newton step overshoots the stick zone; halving
+// lands on either side and the iterates cycle (A6 with mu 0.5, step 708: period
+// 3, |p|/dt 7e-4..5e-3 m/s for 300 iterations). The zero of phi' lies inside
+// the stick zone, where the next Hessian sees its stiffness mu lambda /
+// (eps_v h). phi' is resolved where phi's differences are round-off.
+enum class LineSearch { Backtracking, Wolfe };
+
 struct NewtonParams {
   double eps_d = 1e-6;     // m/s
   int max_iterations = 100;
   HessianMode hessian = HessianMode::Projected;
+  LineSearch line_search = LineSearch::Wolfe;
   bool log_iterations = false;  // one line per iteration on stderr (rank 0)
 };
 
@@ -52,6 +71,8 @@ struct NewtonStats {
   int projected_retries = 0;       // the step failed with the exact Hessian and was redone projected
   int exact_hessian_iterations = 0; // iterations solved with the exact Hessian
   int projection_fallbacks = 0;     // exact Hessian not positive definite: projected instead
+  int wolfe_steps = 0;              // line searches ended by the strong Wolfe bisection
+  int wolfe_gradients = 0;          // gradient evaluations of those bisections (failed ones too)
 };
 
 // Inputs of one minimisation; all Views node-interleaved, length n_nodes*dim.

@@ -215,6 +215,47 @@ TEST(Probes, CsvOfARealRunEqualsTheRecordedTableAndTornRowsAreHandled) {
   std::filesystem::remove_all(dir);
 }
 
+// The lead_onset probe (A6's buckling onset) on frames with a known motion:
+// a crown group follows a plate moving at -1 m/s with a 0.05 m lag until
+// t = 1 s, then accelerates ahead (u = -t + 0.05 - 2 (t - 1)^2); a second
+// group outside the box runs far ahead from the start and must not count.
+// Lead = -(u + t) = 2 (t - 1)^2 - 0.05 exceeds 0.15 first at t > 1.316 s:
+// the frame at 1.4 s (frames every 0.2 s).
+TEST(Probes, LeadOnsetOfAPointSetAheadOfADrivenTravel) {
+  const std::string dir = (std::filesystem::temp_directory_path() / "bfemp_test_probe_lead").string();
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  auto write = [&](double late) {  // late: the crown's extra acceleration (0: it never leads)
+    Hdf5FrameWriter w(dir + "/bfemp.h5");
+    for (int k = 0; k <= 10; ++k) {
+      const double t = 0.2 * k;
+      const double u = -t + (t > 0 ? 0.05 : 0.0) - (t > 1 ? late * (t - 1) * (t - 1) : 0.0);
+      std::vector<double> x;
+      for (int q = 0; q < 5; ++q) x.push_back(-0.5 + 0.25 * q), x.push_back(10.0 + 0.1 * q + u);
+      x.push_back(5.0), x.push_back(10.0 - 10 * t);  // outside the box, far ahead
+      w.begin_frame(k, t, k);
+      w.write_array("particle_positions", x.data(), x.size() / 2, 2);
+      w.end_frame();
+    }
+    w.close();
+  };
+  write(2.0);
+  RunTable t = table_of(3, 0.0, 1.0, [](double, StepReport&) {});
+  t.set_source_dir(dir);
+  const std::string box = "lead_onset:box_min=-1;9.5,box_max=1;11,speed=-1";
+  EXPECT_NEAR(evaluate_probe(box, t), 1.4, 1e-12);
+  EXPECT_NEAR(evaluate_probe(box + ",threshold=0.5", t), 1.6, 1e-12) << "2 (t - 1)^2 - 0.05 > 0.5 from 1.524 s";
+  EXPECT_NEAR(evaluate_probe("lead_onset:box_min=4;-100,box_max=6;11,speed=-1", t), 0.2, 1e-12)
+      << "the group running ahead";
+  EXPECT_NE(error_of("lead_onset:box_min=-1;9.5,box_max=1;11,speed=0", t).find("nonzero"), std::string::npos);
+  EXPECT_NE(error_of("lead_onset:box_min=7;7,box_max=8;8,speed=-1", t).find("no particle"), std::string::npos);
+  EXPECT_NE(error_of("lead_onset:box_min=-1;9.5;0,box_max=1;11,speed=-1", t).find("2 components"), std::string::npos);
+  EXPECT_NE(error_of("lead_onset:box_min=-1;9.5,box_max=1;11,speed=-1,axis=z", t).find("2D"), std::string::npos);
+  write(0.0);
+  EXPECT_TRUE(std::isnan(evaluate_probe(box, t))) << "a crown that never leads";
+  std::filesystem::remove_all(dir);
+}
+
 // The rotation probe on frames with a known rigid rotation: a ring of points
 // (and a point on the axis, skipped) rotated by omega t about z through
 // (0.5, 0.5) in 2D, and about x in 3D; a second group outside the box moves
