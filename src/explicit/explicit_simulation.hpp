@@ -9,7 +9,11 @@
 //   2. contact nodes: nodes with >= 2 classes; normal and separation per node
 //      (LR Eqs. 19-25 or AG Eq. 13 with Eq. 14 / Eq. 16), 3+ nodes lumped (Eq. 50);
 //   3. contact pass 1 on p^{alpha 0}: Delta p^alpha, stored as Delta v^alpha (Eq. 26)
-//      (skipped with 'contact passes: 1');
+//      (skipped with 'contact passes: 1', the paper's single pass (§4.1): then
+//      v^alpha = v^{alpha 0}, step 4 strains with uncorrected velocities, and
+//      pass 2 finds Delta p^alpha + Delta p^{alpha+}, so that a^alpha of step 7
+//      holds f^{alpha C,0} of Eq. 33; with this USF update it is unstable in
+//      B1(b), see tests/scene/test_explicit_b1_strain.cpp);
 //   4. grid constraints; velocity gradient from v^alpha (Eq. 28), F <- (I + dt L) F,
 //      Cauchy stress from F;
 //   5. forces per material (Eq. 29), p^{alpha 0+} = p^alpha + f^{alpha 0} dt (Eq. 30);
