@@ -21,7 +21,8 @@ def main():
     d = sys.argv[1] if len(sys.argv) > 1 else "build/explicit_b1"
     out = sys.argv[2] if len(sys.argv) > 2 else os.path.join(d, "b1_errors.png")
     pairs = [("lr", "smm_flip", "LR"), ("lr_xpic5", "smm_xpic5", "LR-XPIC(5)"),
-             ("cp08", "smm_flip", "CP=0.8"), ("lr_once", "smm_flip", "LR once")]
+             ("cp08", "smm_flip", "CP=0.8"), ("lr_once", "smm_flip", "LR once"),
+             ("lr_usavg", "smm_flip_usavg", "LR (USAVG)"), ("lr_once_usavg", "smm_flip_usavg", "LR once (USAVG)")]
     try:
         import matplotlib
         matplotlib.use("Agg")

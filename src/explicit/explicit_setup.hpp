@@ -27,6 +27,10 @@ enum class XUpdate { FLIP, PIC, XPIC };
 enum class XNormals { LR, AG };
 // AG separation: Velocity (Eq. 14 alone) or CP (Eq. 16 with delta_c).
 enum class XSeparation { Velocity, CP };
+// When F and sigma are updated (Eq. 28 with v^alpha or v^{alpha+}): before the
+// forces (USF), after the momentum update (USL), or half of the increment each
+// (USAVG). See explicit_simulation.hpp.
+enum class XStrainUpdate { USF, USL, USAVG };
 enum class XModel : int { HyperelasticKG = 0, NeoHookean = 1, Linear = 2 };
 
 struct XMaterial {
@@ -51,6 +55,7 @@ struct ExplicitSetup {
   int xpic_order = 5;
   bool xpic_corrected = true;  // false: the uncorrected XPIC (no Delta v^alpha term, v^{alpha 0})
   int contact_passes = 2;      // 1: the single-pass variant (pass 2 only)
+  XStrainUpdate strain_update = XStrainUpdate::USF;
   XNormals normals = XNormals::LR;
   XSeparation separation = XSeparation::Velocity;  // AG only
   double cp_delta = 0.8;                           // CP: delta_c in cells

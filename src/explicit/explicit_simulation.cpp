@@ -566,10 +566,11 @@ struct StepKernels {
     return active;
   }
 
-  static void stress_update(Impl& s, double dt) {
+  // F <- (I + dt L) F with L = sum_i v_i^alpha (x) G_pi (Eq. 28) from the grid velocities `v`
+  // (v^alpha before the momentum update, v^{alpha+} after it); sigma from F.
+  static void stress_update(Impl& s, double dt, DView v) {
     const auto p = s.p;
     const auto g = s.g;
-    const auto v = s.v;
     const auto mt = s.mats;
     const int M = s.M;
     Kokkos::parallel_for(
@@ -677,7 +678,7 @@ struct StepKernels {
             } else {
               p.v(q, c) = up == XUpdate::PIC ? Svp[c] : m * (Sv1[c] - Svs[c]) + dt * Sa[c];
               // PIC / XPIC positions: X += dt S (v^alpha + dt/2 a^alpha) = dt (S v^{alpha+} - dt/2 S a^alpha),
-              // the lumped (contact-corrected) grid velocity that also drives F (step 4), averaged over
+              // the lumped (contact-corrected) grid velocity that also drives F (steps 4, 6), averaged over
               // the step. Not the XPIC particle velocity: X += dt (V^{n+1} - dt/2 S a) moves the particles
               // with m S (v - v*), a sharpened field (mode factor (1 - (1 - lambda)^m) / lambda of
               // S^{+alpha} S) that F never sees; positions and F then drift apart and single-material
@@ -713,7 +714,9 @@ struct StepKernels {
     t.reset();
     s.velocities(s.pc, s.v, true);
     s.velocities(s.p0, s.v0, true);
-    stress_update(s, dt);
+    const XStrainUpdate su = s.setup.strain_update;
+    if (su == XStrainUpdate::USF) stress_update(s, dt, s.v);
+    else if (su == XStrainUpdate::USAVG) stress_update(s, 0.5 * dt, s.v);
     Kokkos::fence();
     r.stress_s += t.seconds();
     t.reset();
@@ -728,6 +731,13 @@ struct StepKernels {
     r.contact_s += t.seconds();
     t.reset();
     s.velocities(s.vp, s.vp, true);
+    if (su != XStrainUpdate::USF) {
+      // USL / USAVG: (the rest of) the increment from v^{alpha+}, at the positions of this step's P2G
+      stress_update(s, su == XStrainUpdate::USL ? dt : 0.5 * dt, s.vp);
+      Kokkos::fence();
+      r.stress_s += t.seconds();
+      t.reset();
+    }
     g2p(s, dt);
     Kokkos::fence();
     r.g2p_s += t.seconds();

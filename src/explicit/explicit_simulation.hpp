@@ -9,18 +9,41 @@
 //   2. contact nodes: nodes with >= 2 classes; normal and separation per node
 //      (LR Eqs. 19-25 or AG Eq. 13 with Eq. 14 / Eq. 16), 3+ nodes lumped (Eq. 50);
 //   3. contact pass 1 on p^{alpha 0}: Delta p^alpha, stored as Delta v^alpha (Eq. 26)
-//      (skipped with 'contact passes: 1');
-//   4. grid constraints; velocity gradient from v^alpha (Eq. 28), F <- (I + dt L) F,
-//      Cauchy stress from F;
-//   5. forces per material (Eq. 29), p^{alpha 0+} = p^alpha + f^{alpha 0} dt (Eq. 30);
-//   6. contact pass 2: p^{alpha +} (Eq. 31); grid constraints;
+//      (skipped with 'contact passes: 1', the paper's single pass (§4.1): then
+//      v^alpha = v^{alpha 0}, a USF step 4 strains with uncorrected velocities,
+//      and pass 2 finds Delta p^alpha + Delta p^{alpha+}, so that a^alpha of
+//      step 7 holds f^{alpha C,0} of Eq. 33; with USF this is unstable in
+//      B1(b), see tests/scene/test_explicit_b1_strain.cpp);
+//   4. grid constraints; strain update before the forces (setup.strain_update):
+//      L = sum_i v_i^alpha (x) G_pi (Eq. 28), F <- (I + h L) F, sigma from F,
+//      with h = dt (USF), h = dt/2 (USAVG) or not at all (USL);
+//   5. forces per material (Eq. 29) from that sigma,
+//      p^{alpha 0+} = p^alpha + f^{alpha 0} dt (Eq. 30);
+//   6. contact pass 2: p^{alpha +} (Eq. 31); grid constraints; strain update
+//      after the momentum update: Eq. 28 with v^{alpha+} instead of v^alpha,
+//      F <- (I + h L+) F, sigma from F, with h = dt (USL) or dt/2 (USAVG);
+//      both at the particle positions of step 1 (before step 7 moves them);
 //   7. particle update with a^alpha = (v^{alpha+} - v^alpha)/dt (Eqs. 32-34):
 //      FLIP: V += dt S a, X += dt S v^+;  PIC: V = S v^+;
 //      XPIC(m): V = m S (v^alpha - v*^alpha) + dt S a (Eqs. 41-44);
 //      PIC / XPIC positions: X += dt (S v^{alpha+} - dt/2 S a) = dt S (v^alpha + dt/2 a),
-//      the lumped grid velocity that also updates F (step 4), not the XPIC
+//      the lumped grid velocity that also updates F (steps 4, 6), not the XPIC
 //      particle velocity (a sharpened field F never sees: positions and F
 //      drift apart; single-material XPIC(5) in B1(b) blew up at 16.6 % strain).
+// Strain update orderings ('Explicit/strain update'; paper 001 §3.2: codes
+// differ, after Eq. 27; with two passes the contact calculations work for any
+// of them, after Eq. 34):
+//   USF   (default): dt L from v^alpha (Eq. 26) before the forces, which then
+//         come from the stress of this step's start velocities;
+//   USL:  dt L from v^{alpha+} (Eq. 31) after pass 2; this step's forces come
+//         from the stress of the previous step's final velocities;
+//   USAVG: dt/2 from v^alpha before the forces, dt/2 from v^{alpha+} after.
+// USL and USAVG here are NairnMPM's USL- / USAVG-: the second half uses the
+// grid velocities v^{alpha+} as they are, without the second particle-to-grid
+// extrapolation of NairnMPM's '+' variants (its default is USAVG+, which
+// bfemp does not implement). With one pass, v^alpha = v^{alpha 0}: USF then
+// strains with uncorrected velocities only (the paper's second flaw, §4.1);
+// USL never uses v^{alpha 0} and USAVG only for half of each increment.
 // Contact acts when the materials approach (Eq. 14) AND are touching
 // (d_LR < 0, or Eq. 16 for CP; the velocity-only AG method tests approach
 // alone); the stick law always acts.

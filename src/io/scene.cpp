@@ -443,7 +443,8 @@ std::string scene_summary(const Scene& scene) {
                        : up)
       << ", normals " << e.get<std::string>("normals");
     if (e.get<std::string>("normals") == "AG") s << " (" << e.get<std::string>("separation") << ")";
-    s << ", " << e.get<int>("contact passes") << " contact pass(es), law " << e.get<std::string>("law");
+    s << ", " << e.get<int>("contact passes") << " contact pass(es), strain update " << e.get<std::string>("strain update")
+      << ", law " << e.get<std::string>("law");
     if (e.get<std::string>("law") == "coulomb") s << " mu " << e.get<double>("mu");
     s << " (" << e.sublist("Contact Pairs").numParams() << " pair override(s)), ";
     if (e.get<bool>("fixed dt")) s << "dt " << t.get<double>("dt") << " s (fixed)";

@@ -217,6 +217,8 @@ ExplicitSetup<dim> build_explicit_setup(const Scene& scene) {
   s.xpic_order = e.get<int>("XPIC order");
   s.xpic_corrected = e.get<std::string>("XPIC correction") == "corrected";
   s.contact_passes = e.get<int>("contact passes");
+  const std::string su = e.get<std::string>("strain update");
+  s.strain_update = su == "USL" ? XStrainUpdate::USL : su == "USAVG" ? XStrainUpdate::USAVG : XStrainUpdate::USF;
   s.normals = e.get<std::string>("normals") == "LR" ? XNormals::LR : XNormals::AG;
   s.separation = e.get<std::string>("separation") == "CP" ? XSeparation::CP : XSeparation::Velocity;
   s.cp_delta = e.get<double>("CP");

@@ -202,6 +202,12 @@ Teuchos::RCP<const ParameterList> scene_schema() {
   choice(ex, "XPIC correction", "corrected", "multimaterial term of Eq. 37 (uncorrected: without it)",
          tuple<std::string>("corrected", "uncorrected"));
   ex.set("contact passes", 2, "contact corrections per step: 2 (Eqs. 26, 31) or 1 (pass 2 only)");
+  choice(ex, "strain update", "USF",
+         "when F and the stress are updated (Eq. 28): USF before the forces from v^alpha (Eq. 26); USL after "
+         "the momentum update from v^{alpha+} (Eq. 31); USAVG dt/2 before from v^alpha, dt/2 after from "
+         "v^{alpha+}. USL / USAVG are NairnMPM's USL- / USAVG- (no second extrapolation); NairnMPM's default "
+         "USAVG+ is not implemented. With 'contact passes: 1' USF strains from uncorrected velocities",
+         tuple<std::string>("USF", "USL", "USAVG"));
   choice(ex, "normals", "LR", "contact normal and separation: logistic regression (Eqs. 19-25) or AG (Eq. 13)",
          tuple<std::string>("LR", "AG"));
   choice(ex, "separation", "velocity", "AG only: approach alone (Eq. 14) or CP offset (Eq. 16)",

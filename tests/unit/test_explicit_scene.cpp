@@ -49,12 +49,20 @@ TEST(ExplicitScene, B1InputsBuild) {
   }
 }
 
+TEST(ExplicitScene, StrainUpdateReachesTheSetup) {
+  EXPECT_EQ(build_explicit_setup<2>(load_scene(kFile)).strain_update, XStrainUpdate::USF);  // the default
+  EXPECT_EQ(build_explicit_setup<2>(load_scene(kFile, {"Explicit/strain update=USL"})).strain_update, XStrainUpdate::USL);
+  EXPECT_EQ(build_explicit_setup<2>(load_scene(kFile, {"Explicit/strain update=USAVG"})).strain_update,
+            XStrainUpdate::USAVG);
+}
+
 TEST(ExplicitScene, BadValuesAreRefusedNamingTheKey) {
   refused({"Explicit/XPIC order=0"}, "Explicit/XPIC order' = 0: expected an integer >= 1");
   refused({"Explicit/mu=-0.1"}, "Explicit/mu' = -0.1: expected a friction coefficient >= 0");
   refused({"Time/CFL=1.5"}, "Time/CFL' = 1.5: expected a value in \\(0, 1\\]");
   refused({"Time/CFL=0"}, "Time/CFL' = 0");
   refused({"Explicit/contact passes=3"}, "Explicit/contact passes' = 3: expected 1 or 2");
+  refused({"Explicit/strain update=USAVG+"}, "Explicit/strain update' = 'USAVG\\+': expected one of 'USF', 'USL', 'USAVG'");
   refused({"Explicit/law=glue"}, "Explicit/law");
   refused({"Explicit/normals=DF"}, "Explicit/normals");
   refused({"Explicit/stress body=nobody"}, "Explicit/stress body' = 'nobody'");

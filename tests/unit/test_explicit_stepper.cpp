@@ -11,6 +11,10 @@
 //    P = I - (I - S S^+)^m (Eq. 36; m = 1: S S^+ V), and the positions move
 //    with the lumped grid velocity S S^+ V (the field that updates F), not
 //    with the XPIC particle velocity P V.
+//  - 2D, one class, a pre-strained block at rest, one step with each strain
+//    update (Explicit/strain update): USF strains from v^alpha = 0 (F
+//    unchanged), USL from v^{alpha+} (dt L+), USAVG half of that; the forces,
+//    hence particle velocities and positions, are the same in all three.
 // No walls, no gravity; uGIMP, 2 particles per cell per axis.
 #include <gtest/gtest.h>
 
@@ -186,6 +190,58 @@ TEST(ExplicitStepper, PicXpicPositionsMoveWithTheLumpedGridVelocity) {
     EXPECT_LT(e_vel, 1e-6) << "m = " << m;
     if (m > 1) EXPECT_GT(pv_vs_u, 1e-2);  // the check can tell the two position updates apart
   }
+}
+
+TEST(ExplicitStepper, StrainUpdateOrderingsFromRest) {
+  const double dx = 0.01, dt = 1e-6;  // CFL limit 0.5 dx / c = 2.6e-6 s
+  const double F0[2][2] = {{1.002, 0.001}, {0.0, 0.997}};
+  struct Out {
+    std::vector<double> F, x, v;
+  };
+  auto one_step = [&](XStrainUpdate su) {
+    ExplicitSetup<2> s = base<2>(1, dx, 12, xmpm::ContactLaw::Frictionless);
+    s.strain_update = su;
+    s.fixed_dt = dt;
+    s.particles = block<2>({0.003, -0.002}, {0.04, 0.04}, dx, 0, {0.0, 0.0});
+    auto hF = Kokkos::create_mirror_view(s.particles.F);
+    for (std::size_t q = 0; q < s.particles.size(); ++q)
+      for (int i = 0; i < 2; ++i)
+        for (int j = 0; j < 2; ++j) hF(q, i, j) = F0[i][j];
+    Kokkos::deep_copy(s.particles.F, hF);
+    ExplicitSimulation<2> sim(s);
+    sim.step();
+    const auto F = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), sim.particles().F);
+    const auto x = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), sim.particles().x);
+    const auto v = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), sim.particles().v);
+    Out o;
+    for (std::size_t q = 0; q < x.extent(0); ++q)
+      for (int i = 0; i < 2; ++i) {
+        o.x.push_back(x(q, i));
+        o.v.push_back(v(q, i));
+        for (int j = 0; j < 2; ++j) o.F.push_back(F(q, i, j));
+      }
+    return o;
+  };
+  const Out f = one_step(XStrainUpdate::USF), l = one_step(XStrainUpdate::USL), a = one_step(XStrainUpdate::USAVG);
+  double usf_change = 0, dl_max = 0, avg_vs_half = 0, vmax = 0;
+  for (std::size_t k = 0; k < f.F.size(); ++k) {
+    const double f0 = F0[(k / 2) % 2][k % 2];
+    usf_change = std::fmax(usf_change, std::fabs(f.F[k] - f0));
+    dl_max = std::fmax(dl_max, std::fabs(l.F[k] - f0));
+    avg_vs_half = std::fmax(avg_vs_half, std::fabs((a.F[k] - f0) - 0.5 * (l.F[k] - f0)));
+  }
+  for (double x : f.v) vmax = std::fmax(vmax, std::fabs(x));
+  std::printf("pre-strained block at rest, one step: max |F - F0| USF %.3g, USL %.3g; max |dF_USAVG - dF_USL / 2| = %.3g; "
+              "max |V| %.3g m/s\n",
+              usf_change, dl_max, avg_vs_half, vmax);
+  EXPECT_EQ(usf_change, 0.0);        // L from v^alpha = 0
+  EXPECT_GT(dl_max, 1e-6);           // L+ from v^{alpha+} = f dt / m at the block's edges
+  EXPECT_LT(avg_vs_half, 1e-9 * dl_max);
+  EXPECT_GT(vmax, 0.01);
+  EXPECT_EQ(f.v, l.v);  // the forces come from sigma(F0) in all three
+  EXPECT_EQ(f.v, a.v);
+  EXPECT_EQ(f.x, l.x);
+  EXPECT_EQ(f.x, a.x);
 }
 
 }  // namespace
