@@ -308,26 +308,39 @@ double rotation(const std::string& h5, const std::vector<double>& lo, const std:
 
 double lead_onset(const std::string& h5, const std::vector<double>& lo, const std::vector<double>& hi, int axis,
                   double speed, double threshold) {
+  auto num = [](double v) {
+    std::ostringstream o;
+    o << v;
+    return o.str();
+  };
   if (!(speed != 0) || !std::isfinite(speed))
-    throw std::invalid_argument("probe lead_onset: speed = " + std::to_string(speed) + ", expected a nonzero number");
+    throw std::invalid_argument("probe lead_onset: speed = " + num(speed) + ", expected a nonzero number");
+  if (!(threshold > 0) || !std::isfinite(threshold))
+    throw std::invalid_argument("probe lead_onset: threshold = " + num(threshold) + ", expected a number > 0 (m)");
   const int frames = particle_frames(h5, "lead_onset");
-  std::vector<std::size_t> shape;
-  const std::vector<double> x0 = read_dataset(h5, frame_group(0) + "/particle_positions", &shape);
-  const std::size_t dim = shape.size() > 1 ? shape[1] : 1;
+  std::vector<std::size_t> shape0;
+  const std::vector<double> x0 = read_dataset(h5, frame_group(0) + "/particle_positions", &shape0);
+  const std::size_t dim = shape0.size() > 1 ? shape0[1] : 1;
   if (lo.size() != dim || hi.size() != dim)
-    throw std::invalid_argument("probe lead_onset: box_min and box_max need " + std::to_string(dim) +
-                                " components (x;y" + std::string(dim == 3 ? ";z" : "") + ")");
-  if (axis >= int(dim)) throw std::invalid_argument("probe lead_onset: axis z in a 2D run");
+    throw std::invalid_argument("probe lead_onset: box_min and box_max have " + std::to_string(lo.size()) + " and " +
+                                std::to_string(hi.size()) + " components, expected " + std::to_string(dim) + " (x;y" +
+                                std::string(dim == 3 ? ";z" : "") + ")");
+  if (axis >= int(dim))
+    throw std::invalid_argument("probe lead_onset: axis = z, expected x or y in a 2D run");
   const std::vector<std::size_t> sel = particles_in_box(x0, dim, lo, hi);
   if (sel.empty()) throw std::invalid_argument("probe lead_onset: no particle inside [box_min, box_max] at frame 0");
   const double sign = speed > 0 ? 1.0 : -1.0;
+  const double t0 = read_attribute(h5, frame_group(0), "time");  // a restarted run's frame 0 is its checkpoint's
   for (int k = 1; k < frames; ++k) {
-    const std::vector<double> x = read_dataset(h5, frame_group(k) + "/particle_positions", nullptr);
+    std::vector<std::size_t> shape;
+    const std::vector<double> x = read_dataset(h5, frame_group(k) + "/particle_positions", &shape);
+    if (shape != shape0)
+      throw std::invalid_argument("probe lead_onset: frame " + std::to_string(k) + " has another particle count than frame 0");
     double u = 0;
     for (const std::size_t q : sel) u += x[q * dim + axis] - x0[q * dim + axis];
     u /= double(sel.size());
     const double t = read_attribute(h5, frame_group(k), "time");
-    if (sign * (u - speed * t) > threshold) return t;
+    if (sign * (u - speed * (t - t0)) > threshold) return t;
   }
   return kNaN;
 }

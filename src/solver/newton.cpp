@@ -466,6 +466,7 @@ NewtonStats NewtonSolver<dim>::minimize(const IncrementalPotential& ip, View1 x)
                 break;
               }
               (dc < 0 ? a : b) = c;
+              if ((b - a) * p_inf < 1e-3 * m.params.eps_d * ip.dt) break;  // below the stall test's resolution
             }
           }
           if (found > 0) {

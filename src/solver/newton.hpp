@@ -41,8 +41,10 @@ enum class HessianMode { Projected, ExactIfDefinite };
 //   Wolfe: when phi(alpha_0) > phi(0) and phi'(alpha_0) > 0, first bisect the
 //     bracket (0, alpha_0) on the sign of phi' (one gradient evaluation each)
 //     until |phi'(alpha)| <= 0.1 |phi'(0)| (the strong Wolfe curvature
-//     condition), and take that alpha if phi(alpha) <= phi(0); otherwise (no
-//     sign change, 50 bisections, or the energy rose) backtracking.
+//     condition), and take that alpha if phi(alpha) <= phi(0) (the same
+//     no-rise test as halving, not Armijo's sufficient decrease); otherwise
+//     (no sign change, a bracket narrower than the stall test's 1e-3 eps_d dt
+//     along p, 50 bisections, or the energy rose) backtracking.
 // Why Wolfe: the lagged friction energy mu lambda f0(|u_t|) is a rounded V of
 // width eps_v h about u_t = 0. On the slip side its Hessian has no curvature
 // along a 1D tangent (2D), so the Newton step overshoots the stick zone; halving

@@ -94,7 +94,7 @@ TEST(NewtonLineSearch, WolfeLandsInTheStickZoneAndConverges) {
   // s = x_0 / eh: s^2 - (2 + eh) s + 0.3 = 0. Newton stops at |p| < eps_d dt.
   const double b = 2.0 + kEh;
   const double s = 0.5 * (b - std::sqrt(b * b - 1.2));
-  EXPECT_NEAR(w.x0, s * kEh, 1e-6 * 0.01);
+  EXPECT_NEAR(w.x0, s * kEh, 1e-3 * kEh);  // quadratic inside the zone: far below eps_d dt = 1e-8
   EXPECT_GE(w.st.wolfe_steps, 1);
   EXPECT_LE(w.st.iterations, 6);
   std::printf("Wolfe: %d Newton iterations, %d Wolfe steps, %d gradient evaluations, x_0 = %.3e m\n",
@@ -107,9 +107,9 @@ TEST(NewtonLineSearch, BacktrackingNeedsMoreIterationsOrFails) {
   EXPECT_EQ(b.st.wolfe_gradients, 0);
   std::printf("backtracking: %s, %d Newton iterations, x_0 = %.3e m\n", b.error.empty() ? "converged" : b.error.c_str(),
               b.st.iterations, b.x0);
-  if (b.error.empty()) {
-    EXPECT_GT(b.st.iterations, w.st.iterations);
-  }
+  // Measured: 20 iterations against Wolfe's 3 (a failure of the solve counts as worse).
+  EXPECT_TRUE(!b.error.empty() || b.st.iterations >= 3 * w.st.iterations)
+      << b.st.iterations << " backtracking iterations against " << w.st.iterations;
 }
 
 }  // namespace
