@@ -205,6 +205,8 @@ Json run_case(const std::string& size, const std::string& solver, const Options&
       m.assembly_s += n.assembly_s;
       m.solve_s += n.solve_s;
       m.line_search_s += n.line_search_s;
+      m.wolfe_steps += n.wolfe_steps;
+      m.wolfe_gradients += n.wolfe_gradients;
       step_s += last.step_s;
       graph_s += sim.newton().last_graph_build_s();
       active = last.active_grid_nodes;
@@ -230,6 +232,8 @@ Json run_case(const std::string& size, const std::string& solver, const Options&
         .num("assembly_s", m.assembly_s / it)
         .num("solve_s", solve_steady / it)
         .num("line_search_s", m.line_search_s / it)
+        .integer("wolfe_steps", m.wolfe_steps)          // Newton/line search: steps from the bisection
+        .integer("wolfe_gradients", m.wolfe_gradients)  // and its gradient evaluations (in line_search_s)
         .num("iteration_s", (m.assembly_s + solve_steady + m.line_search_s) / it)
         .num("symbolic_per_step_s", direct ? first_extra / o.steps : 0.0)
         .num("pre_newton_per_step_s", pre_s / o.steps)
