@@ -124,17 +124,17 @@ void MpmBodies<dim>::replace_particles(const Particles<dim>& all) {
 template <int dim>
 long long MpmBodies<dim>::migrate() {
   if (!distributed_) return 0;
-  long long moved = migrate_particles(setup_.particles, ids_, slabs_, *comm_);
-  moved += rebalance();
+  long long largest = 0;
+  long long moved = migrate_particles(setup_.particles, ids_, slabs_, *comm_, largest);
+  moved += rebalance(largest);
   if (moved > 0) resize_stencils();
   migrated_ += moved;
   return moved;
 }
 
 template <int dim>
-long long MpmBodies<dim>::rebalance() {
-  const double mine = static_cast<double>(setup_.particles.size());
-  const double largest = all(mine, Teuchos::REDUCE_MAX);
+long long MpmBodies<dim>::rebalance(long long largest_count) {
+  const double largest = static_cast<double>(largest_count);
   const double mean = static_cast<double>(n_total_) / comm_->getSize();
   imbalance_ = mean > 0 ? largest / mean : 1.0;
   const double above = setup_.rebalance_above;
@@ -149,8 +149,9 @@ long long MpmBodies<dim>::rebalance() {
   slabs_ = s;
   retry_above_ = 0.0;
   ++rebalances_;
-  const long long moved = migrate_particles(setup_.particles, ids_, slabs_, *comm_);
-  imbalance_ = mean > 0 ? all(static_cast<double>(setup_.particles.size()), Teuchos::REDUCE_MAX) / mean : 1.0;
+  long long after = 0;
+  const long long moved = migrate_particles(setup_.particles, ids_, slabs_, *comm_, after);
+  imbalance_ = mean > 0 ? static_cast<double>(after) / mean : 1.0;
   return moved;
 }
 

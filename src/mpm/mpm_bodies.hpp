@@ -175,7 +175,7 @@ class MpmBodies {
   long long n_total_ = 0, migrated_ = 0;
   int rebalances_ = 0;
   double imbalance_ = 1.0, retry_above_ = 0.0;  // retry_above_: a failed rebalance waits for more imbalance
-  long long rebalance();
+  long long rebalance(long long largest_count);  // largest_count: from the migration's reduction
   LO owned_ = 0;
   std::vector<GO> global_nodes_;
   struct Halo;

@@ -231,14 +231,21 @@ Particles<dim> select_slab(const Particles<dim>& all, const ParticleSlabs<dim>& 
 
 template <int dim>
 long long migrate_particles(Particles<dim>& p, Kokkos::View<long long*, MemSpace>& ids, const ParticleSlabs<dim>& slabs,
-                            const Teuchos::Comm<int>& comm) {
+                            const Teuchos::Comm<int>& comm, long long& largest) {
   const int me = comm.getRank(), n = comm.getSize();
+  largest = static_cast<long long>(p.size());
   if (n == 1) return 0;
   std::vector<long long> count;
   auto order = group_by_owner(p, slabs, me, count);
   const long long np = static_cast<long long>(p.size());
-  long long leaving = np - count[me], moved = 0;
-  Teuchos::reduceAll(comm, Teuchos::REDUCE_SUM, leaving, Teuchos::outArg(moved));
+  // One allreduce: summed over the senders, count[r] is rank r's particle
+  // count after the exchange, and the appended entry (this rank's leavers)
+  // the number that move.
+  std::vector<long long> mine(count.begin(), count.end()), all(n + 1, 0);
+  mine.push_back(np - count[me]);
+  Teuchos::reduceAll(comm, Teuchos::REDUCE_SUM, n + 1, mine.data(), all.data());
+  largest = *std::max_element(all.begin(), all.begin() + n);
+  const long long moved = all[n];
   if (moved == 0) return 0;
   constexpr int nf = kFields<dim>;
   Buffer buf("mpm_migrate_buffer", np, nf);
@@ -335,7 +342,7 @@ std::vector<double> gather_particle_values(Kokkos::View<const double*, MemSpace>
   template Particles<D> select_slab<D>(const Particles<D>&, const ParticleSlabs<D>&, int,                          \
                                        Kokkos::View<long long*, MemSpace>&);                                        \
   template long long migrate_particles<D>(Particles<D>&, Kokkos::View<long long*, MemSpace>&,                      \
-                                          const ParticleSlabs<D>&, const Teuchos::Comm<int>&);                      \
+                                          const ParticleSlabs<D>&, const Teuchos::Comm<int>&, long long&);          \
   template Particles<D> gather_particles<D>(const Particles<D>&, Kokkos::View<const long long*, MemSpace>, long long, \
                                             const Teuchos::Comm<int>&, int);
 BFEMP_INSTANTIATE(2)

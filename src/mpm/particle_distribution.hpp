@@ -62,10 +62,12 @@ Particles<dim> select_slab(const Particles<dim>& all, const ParticleSlabs<dim>& 
 
 // Sends every particle outside this rank's slab to its owner and receives
 // those entering (collective). p and ids are replaced when anything moved
-// anywhere. Returns the number of particles that moved, summed over ranks.
+// anywhere. Returns the number of particles that moved, summed over ranks,
+// and sets `largest` to the largest rank's particle count after the exchange:
+// both come from one allreduce of the per-destination counts.
 template <int dim>
 long long migrate_particles(Particles<dim>& p, Kokkos::View<long long*, MemSpace>& ids, const ParticleSlabs<dim>& slabs,
-                            const Teuchos::Comm<int>& comm);
+                            const Teuchos::Comm<int>& comm, long long& largest);
 
 // All ranks' particles on rank `root`, placed by id (0..n_total-1); other
 // ranks get an empty set (collective).

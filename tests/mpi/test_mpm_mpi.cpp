@@ -367,3 +367,59 @@ TEST(MpmMpi, RebalancedCutsCountParticlesOutsideTheGridOnTheirSide) {
   Teuchos::reduceAll(*world, Teuchos::REDUCE_MAX, k, mine.data(), hi.data());
   EXPECT_EQ(lo, hi) << "the ranks computed different cuts";
 }
+
+// migrate_particles' counts from its one reduction: 12 particles at x = 0.05,
+// 0.15, ..., 1.15 (ids 0..11), all starting on rank 0, in slabs cut at
+// 0.4, 0.8, ... (2 ranks: at 0.4 only). Every rank must report the same moved
+// total (the particles outside slab 0) and the largest slab's count after
+// the exchange, and hold exactly the particles of its own slab.
+TEST(MpmMpi, MigrationReportsMovedAndLargestFromOneReduction) {
+  auto world = Tpetra::getDefaultComm();
+  const int me = world->getRank(), n = world->getSize();
+  const int np = me == 0 ? 12 : 0;
+  Particles<2> p = allocate_particles<2>(np);
+  Kokkos::View<long long*, MemSpace> ids("ids", np);
+  auto xh = Kokkos::create_mirror_view(p.x);
+  auto ih = Kokkos::create_mirror_view(ids);
+  for (int q = 0; q < np; ++q) {
+    xh(q, 0) = 0.05 + 0.1 * q;
+    xh(q, 1) = 0.5;
+    ih(q) = q;
+  }
+  Kokkos::deep_copy(p.x, xh);
+  Kokkos::deep_copy(ids, ih);
+  ParticleSlabs<2> slabs;
+  slabs.axis = 0;
+  slabs.nranks = n;
+  slabs.cuts = decltype(slabs.cuts)("cuts", n - 1);
+  auto ch = Kokkos::create_mirror_view(slabs.cuts);
+  for (int k = 0; k + 1 < n; ++k) ch(k) = 0.4 * (k + 1);
+  Kokkos::deep_copy(slabs.cuts, ch);
+  long long largest = -1;
+  const long long moved = migrate_particles<2>(p, ids, slabs, *world, largest);
+  // Slab counts: x < 0.4: 4 particles; 0.4 <= x < 0.8: 4; the rest 4 (3 ranks).
+  if (n == 1) {
+    EXPECT_EQ(moved, 0);
+    EXPECT_EQ(largest, 12);
+  } else if (n == 2) {
+    EXPECT_EQ(moved, 8);
+    EXPECT_EQ(largest, 8);
+    EXPECT_EQ(static_cast<int>(p.size()), me == 0 ? 4 : 8);
+  } else if (n == 3) {
+    EXPECT_EQ(moved, 8);
+    EXPECT_EQ(largest, 4);
+    EXPECT_EQ(static_cast<int>(p.size()), 4);
+  }
+  long long total = 0, mine = static_cast<long long>(p.size());
+  Teuchos::reduceAll(*world, Teuchos::REDUCE_SUM, mine, Teuchos::outArg(total));
+  EXPECT_EQ(total, 12);
+  long long largest_seen = 0;
+  Teuchos::reduceAll(*world, Teuchos::REDUCE_MAX, mine, Teuchos::outArg(largest_seen));
+  EXPECT_EQ(largest, largest_seen);
+  auto xa = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), p.x);
+  for (std::size_t q = 0; q < p.size(); ++q) {
+    const double x = xa(q, 0);
+    if (me > 0) EXPECT_GE(x, ch(me - 1));
+    if (me + 1 < n) EXPECT_LT(x, ch(me));
+  }
+}
