@@ -4,12 +4,14 @@ scenes with `bfemp run`, measures each band with `bfemp probe` (the probes the
 tests use), and writes OUT/report.md (one row per band) with a PNG per scene
 drawn from the runs' own diagnostics.csv.
 
-    validate.py [--size ci|paper] [--scenes A1,A2,A3,A4,A6] [--out DIR] [--bfemp PATH]
+    validate.py [--size ci|paper] [--scenes A1,A2,A3,A4,A6[,A7]] [--out DIR] [--bfemp PATH]
 
 Scenes: A1 rings (APIC, FLIP), A2 sine press (BFEMP and the level-set
 boundary), A3 Brazilian disk (linear, neo-Hookean), A4 box on a slope (mu = 0,
 0.1, 0.1999, 0.2), A6 semicircular rings (mu = 0, 0.2, 0.5; the crown's
-buckling onset, read from the frames). A5 (refinement) is a sweep: scripts/run_sweeps.sh --only a5. Each run goes into OUT/<run>/
+buckling onset, read from the frames), and on request A7 (3D twist, mu = 0,
+0.2, 0.5, 1.0; the slip angle of the cube's top centre; 15-60 minutes per run
+at the ci size). A5 (refinement) is a sweep: scripts/run_sweeps.sh --only a5. Each run goes into OUT/<run>/
 (bfemp.xdmf for ParaView, diagnostics.csv, log.txt). Threads: OMP_NUM_THREADS
 (default 2). Exit status 0 when every band that applies passes, 1 otherwise.
 Plots need matplotlib (Debian's python3-matplotlib); without it the report
@@ -141,6 +143,22 @@ def scenes(size):
         "notes": {"ci": ["at dx = 0.5 the inner ring is 4 cells thick; with mu = 0.5 it still buckles (later and "
                          "more slowly than with 0.2), where the paper shows no buckling (validation/a6/README.md)"]},
     }
+    # A7: the cube's top centre (particles with |x|, |y| < 0.25, z > 0.85 at
+    # t = 0) turns with the shell's cap (pi/5 rad/s from t = 1 s, 0.9 pi in
+    # all) until it slips; its peak rotation is the slip angle.
+    a7_top = "peak_rotation:box_min=-0.25;-0.25;0.85,box_max=0.25;0.25;1.0,center=0;0;0,axis=z"
+    s["A7"] = {
+        "title": "A7 3D twist with friction (section 6.7, Fig. 17)",
+        "runs": [("A7_mu%s" % mu, scene_path(size, "a7_twist.yaml"), ["Contact/friction=%s" % mu])
+                 for mu in ("0", "0.2", "0.5", "1.0")],
+        "bands": [("A7_mu%s" % mu, "slip angle: peak twist of the cube's top centre / pi", a7_top, paper,
+                   (lambda v, lo=lo, hi=hi: lo <= v <= hi), text, math.pi)
+                  for mu, paper, lo, hi, text in (("0", "0.1", 0.0, 0.2, "0.1 +- 0.1"),
+                                                   ("0.2", "0.3", 0.2, 0.4, "0.3 +- 0.1"),
+                                                   ("0.5", "0.7", 0.6, 0.8, "0.7 +- 0.1"),
+                                                   ("1.0", "no slip (0.9)", 0.8, 1.0, ">= 0.8 (follows to 0.9)"))],
+        "plot_dirs": lambda plt, out, dirs: plot_a7(plt, out, dirs, size),
+    }
     return s
 
 
@@ -242,6 +260,14 @@ def plot_a4(plt, out, runs):
 def plot_a6(plt, out, dirs, size):
     # The crown curves read the runs' frames (h5py): scripts/plot_a6.py.
     subprocess.run([sys.executable, os.path.join(REPO, "scripts", "plot_a6.py"), out] +
+                   ["%s=%s" % (name.split("_mu")[1], d) for name, d in dirs.items()] +
+                   ["--title", "%s size" % size],
+                   check=True, stdout=subprocess.DEVNULL)
+
+
+def plot_a7(plt, out, dirs, size):
+    # The top-centre rotation reads the runs' frames (h5py): scripts/plot_a7.py.
+    subprocess.run([sys.executable, os.path.join(REPO, "scripts", "plot_a7.py"), out] +
                    ["%s=%s" % (name.split("_mu")[1], d) for name, d in dirs.items()] +
                    ["--title", "%s size" % size],
                    check=True, stdout=subprocess.DEVNULL)

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # The validation report of the BFEMP scenes (VALIDATION.md section A):
-#   scripts/validate.sh [--size ci|paper] [--scenes A1,A2,A3,A4,A6] [--out DIR]
+#   scripts/validate.sh [--size ci|paper] [--scenes A1,A2,A3,A4,A6[,A7]] [--out DIR]
 # runs each scene with build/drivers/bfemp, evaluates its bands with
 # `bfemp probe` and writes DIR/report.md plus a PNG per scene (see
 # scripts/validate.py --help). Build first: ninja -C build bfemp.

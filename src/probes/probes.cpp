@@ -272,38 +272,68 @@ std::vector<std::size_t> particles_in_box(const std::vector<double>& x0, std::si
 
 }  // namespace
 
+namespace {
+
+// Mean rotation about `axis` through `center` from frame 0 to each frame in
+// `picks`, of the particles in [lo, hi] at frame 0 (see probe::rotation).
+std::vector<double> rotations(const std::string& h5, const std::string& probe, const std::vector<double>& lo,
+                              const std::vector<double>& hi, const std::vector<double>& center, int axis,
+                              const std::vector<int>& picks) {
+  std::vector<std::size_t> shape;
+  const std::vector<double> x0 = read_dataset(h5, frame_group(0) + "/particle_positions", &shape);
+  const std::size_t dim = shape.size() > 1 ? shape[1] : 1;
+  if (lo.size() != dim || hi.size() != dim || center.size() != dim)
+    throw std::invalid_argument("probe " + probe + ": box_min, box_max and center need " + std::to_string(dim) +
+                                " components (x;y" + std::string(dim == 3 ? ";z" : "") + ")");
+  if (dim == 2 && axis != 2) throw std::invalid_argument("probe " + probe + ": 2D rotates about z only (axis=z)");
+  const int i = (axis + 1) % 3, j = (axis + 2) % 3;  // the plane of the rotation
+  std::vector<std::size_t> sel;
+  for (const std::size_t q : particles_in_box(x0, dim, lo, hi)) {
+    const double a0 = x0[q * dim + i] - center[i], b0 = x0[q * dim + j] - center[j];
+    if (a0 * a0 + b0 * b0 >= 1e-24) sel.push_back(q);  // on the axis: no angle
+  }
+  if (sel.empty())
+    throw std::invalid_argument("probe " + probe + ": no particle inside [box_min, box_max] off the axis at frame 0");
+  std::vector<double> out;
+  for (const int k : picks) {
+    const std::vector<double> x1 =
+        k == 0 ? x0 : read_dataset(h5, frame_group(k) + "/particle_positions", nullptr);
+    double sum = 0;
+    for (const std::size_t q : sel) {
+      const double a0 = x0[q * dim + i] - center[i], b0 = x0[q * dim + j] - center[j];
+      const double a1 = x1[q * dim + i] - center[i], b1 = x1[q * dim + j] - center[j];
+      sum += std::atan2(a0 * b1 - b0 * a1, a0 * a1 + b0 * b1);
+    }
+    out.push_back(sum / double(sel.size()));
+  }
+  return out;
+}
+
+}  // namespace
+
 double rotation(const std::string& h5, const std::vector<double>& lo, const std::vector<double>& hi,
                 const std::vector<double>& center, int axis, double time) {
-  const auto frame = frame_group;
   const int frames = particle_frames(h5, "rotation");
   int pick = frames - 1;
   if (std::isfinite(time)) {
     double best = kInf;
     for (int k = 0; k < frames; ++k) {
-      const double d = std::abs(read_attribute(h5, frame(k), "time") - time);
+      const double d = std::abs(read_attribute(h5, frame_group(k), "time") - time);
       if (d < best) best = d, pick = k;
     }
   }
-  std::vector<std::size_t> shape;
-  const std::vector<double> x0 = read_dataset(h5, frame(0) + "/particle_positions", &shape);
-  const std::size_t dim = shape.size() > 1 ? shape[1] : 1;
-  const std::vector<double> x1 = read_dataset(h5, frame(pick) + "/particle_positions", nullptr);
-  if (lo.size() != dim || hi.size() != dim || center.size() != dim)
-    throw std::invalid_argument("probe rotation: box_min, box_max and center need " + std::to_string(dim) +
-                                " components (x;y" + std::string(dim == 3 ? ";z" : "") + ")");
-  if (dim == 2 && axis != 2) throw std::invalid_argument("probe rotation: 2D rotates about z only (axis=z)");
-  const int i = (axis + 1) % 3, j = (axis + 2) % 3;  // the plane of the rotation
-  double sum = 0;
-  long n = 0;
-  for (const std::size_t q : particles_in_box(x0, dim, lo, hi)) {
-    const double a0 = x0[q * dim + i] - center[i], b0 = x0[q * dim + j] - center[j];
-    const double a1 = x1[q * dim + i] - center[i], b1 = x1[q * dim + j] - center[j];
-    if (a0 * a0 + b0 * b0 < 1e-24) continue;  // on the axis: no angle
-    sum += std::atan2(a0 * b1 - b0 * a1, a0 * a1 + b0 * b1);
-    ++n;
-  }
-  if (n == 0) throw std::invalid_argument("probe rotation: no particle inside [box_min, box_max] off the axis at frame 0");
-  return sum / double(n);
+  return rotations(h5, "rotation", lo, hi, center, axis, {pick})[0];
+}
+
+double peak_rotation(const std::string& h5, const std::vector<double>& lo, const std::vector<double>& hi,
+                     const std::vector<double>& center, int axis) {
+  const int frames = particle_frames(h5, "peak_rotation");
+  std::vector<int> all(frames);
+  for (int k = 0; k < frames; ++k) all[k] = k;
+  double peak = 0;
+  for (const double r : rotations(h5, "peak_rotation", lo, hi, center, axis, all))
+    if (std::abs(r) > std::abs(peak)) peak = r;
+  return peak;
 }
 
 double lead_onset(const std::string& h5, const std::vector<double>& lo, const std::vector<double>& hi, int axis,
@@ -468,6 +498,14 @@ const std::vector<ProbeInfo>& probe_list() {
          auto vec = [&](const std::string& key) { return vector_arg(a, key); };
          return probe::rotation(frames_file(t, a), vec("box_min"), vec("box_max"), vec("center"), a.axis("axis", 2),
                                 t_of(a));
+       }},
+      {"peak_rotation", "box_min=X;Y[;Z],box_max=X;Y[;Z],center=X;Y[;Z][,axis=z]",
+       "the rotation probe's value of largest magnitude over all frames (rad; reads the run's bfemp.h5); A7's "
+       "slip angle: the twist the cube's top follows before it slips",
+       [](const RunTable& t, const ProbeArgs& a) {
+         auto vec = [&](const std::string& key) { return vector_arg(a, key); };
+         return probe::peak_rotation(frames_file(t, a), vec("box_min"), vec("box_max"), vec("center"),
+                                     a.axis("axis", 2));
        }},
       {"lead_onset", "box_min=X;Y[;Z],box_max=X;Y[;Z],speed=V[,axis=y][,threshold=D]",
        "first frame time at which the particles in the box at frame 0 lead a travel speed*t along the axis by "

@@ -34,6 +34,8 @@
 //                     of the particles inside [box_min, box_max] at frame 0,
 //                     at the output frame nearest t (read from the run's
 //                     bfemp.h5; vectors are written x;y[;z]); A7's twist
+//  peak_rotation      rotation's value of largest magnitude over the frames
+//                     (rad): A7's slip angle
 //  lead_onset         first frame time at which the particles inside
 //                     [box_min, box_max] at frame 0 lead a motion at `speed`
 //                     along `axis` (a driven plate: travel = speed t) by more
@@ -98,6 +100,10 @@ double equilibrium_height(const RunTable& t, const std::vector<std::string>& bod
 // run's bfemp.h5. std::invalid_argument when no particle is selected.
 double rotation(const std::string& h5, const std::vector<double>& lo, const std::vector<double>& hi,
                 const std::vector<double>& center, int axis, double time);
+// The value of rotation() of largest magnitude over all frames (signed):
+// how far the point set turned before it slipped back (A7's slip angle).
+double peak_rotation(const std::string& h5, const std::vector<double>& lo, const std::vector<double>& hi,
+                     const std::vector<double>& center, int axis);
 // Time of the first frame whose particles selected in [lo, hi] at frame 0
 // lead the travel speed * t along `axis` by more than `threshold` (above);
 // NaN when no frame does. std::invalid_argument when none is selected or

@@ -291,6 +291,10 @@ TEST(Probes, RotationOfAPointSetFromTheFrames) {
   EXPECT_NEAR(evaluate_probe(box, t), omega * 2.5, 1e-12) << "last frame";
   EXPECT_NEAR(evaluate_probe(box + ",t=1.1", t), omega * 1.0, 1e-12) << "frame nearest 1.1 s: t = 1 s";
   EXPECT_NEAR(evaluate_probe(box + ",t=0", t), 0.0, 1e-15);
+  EXPECT_NEAR(evaluate_probe("peak_rotation:box_min=0;0,box_max=1;1,center=0.5;0.5", t), omega * 2.5, 1e-12)
+      << "a steady rotation peaks at the last frame";
+  EXPECT_NE(error_of("peak_rotation:box_min=5;5,box_max=6;6,center=0.5;0.5", t).find("no particle"),
+            std::string::npos);
   EXPECT_NE(error_of("rotation:box_min=0;0,box_max=1;1,center=0.5;0.5,axis=x", t).find("about z"), std::string::npos);
   EXPECT_NE(error_of("rotation:box_min=5;5,box_max=6;6,center=0.5;0.5", t).find("no particle"), std::string::npos);
   EXPECT_NE(error_of("rotation:box_min=0;0;0,box_max=1;1,center=0.5;0.5", t).find("2 components"), std::string::npos);
@@ -315,5 +319,25 @@ TEST(Probes, RotationOfAPointSetFromTheFrames) {
     w.close();
   }
   EXPECT_NEAR(evaluate_probe("rotation:box_min=-1;0;0,box_max=1;2;2,center=0;1;1,axis=x", t), -0.8, 1e-12);
+  // A point set that turns to 0.7 rad and slips back to 0.2 (A7 after a
+  // slip): the peak, not the end.
+  {
+    Hdf5FrameWriter w(dir + "/bfemp.h5");
+    const double th[] = {0.0, 0.3, 0.7, 0.5, 0.2};
+    for (int k = 0; k < 5; ++k) {
+      std::vector<double> x;
+      for (int q = 0; q < 8; ++q) {
+        const double r = 0.2 + 0.05 * q, a0 = 0.7 * q;
+        x.insert(x.end(), {r * std::cos(a0 + th[k]), r * std::sin(a0 + th[k]), 0.9});
+      }
+      w.begin_frame(k, 0.5 * k, k);
+      w.write_array("particle_positions", x.data(), x.size() / 3, 3);
+      w.end_frame();
+    }
+    w.close();
+  }
+  const std::string top = "box_min=-1;-1;0.8,box_max=1;1;1,center=0;0;0";
+  EXPECT_NEAR(evaluate_probe("peak_rotation:" + top, t), 0.7, 1e-12);
+  EXPECT_NEAR(evaluate_probe("rotation:" + top, t), 0.2, 1e-12);
   std::filesystem::remove_all(dir);
 }
