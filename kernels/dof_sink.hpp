@@ -44,6 +44,11 @@ struct DofSink {
   // projections (the Newton solver's exact-if-definite iterations; the
   // factorisation then decides whether the sum is positive definite).
   bool project = true;
+  // With project: the fraction of the negative curvature of each contact
+  // pair's local Hessian that its projection keeps (project_psd's keep; 0:
+  // the PSD projection). The Newton solver raises it after an indefinite
+  // exact Hessian, so as to add no more stiffness than a factorisation needs.
+  double contact_keep = 0.0;
   // Counts blocks the graph lacks (when allocated): the DOF space rebuilds
   // the graph and reassembles instead of dropping them.
   Kokkos::View<int, typename LocalMatrix::memory_space> dropped;

@@ -239,10 +239,11 @@ template <int dim>
 void BarrierTerm<dim>::assemble(ConstDofView x, const Sink<dim>& sink) const {
   if (n_pairs_ == 0) return;
   const bool project = project_ && sink.project;
+  const double keep = sink.contact_keep;
   for_each_pair(x, [=](LO, const PairDofs<dim>& pd, const auto& g, const auto& H) {
     constexpr int L = std::decay_t<decltype(g)>::RowsAtCompileTime;
     SquareMat<L> Hp = H;
-    if (project) project_psd<L>(Hp);
+    if (project) project_psd<L>(Hp, keep);
     scatter_pair<dim, L>(pd, g, &Hp, sink);
   });
 }

@@ -422,6 +422,10 @@ SimulationSetup<dim> build_setup(const Scene& scene) {
   setup.newton.line_search = p.sublist("Newton").get<std::string>("line search") == "wolfe" ? LineSearch::Wolfe
                                                                                               : LineSearch::Backtracking;
   setup.newton.log_iterations = p.sublist("Newton").get<bool>("log iterations");
+  {
+    const auto keep = p.sublist("Newton").get<Array<double>>("fallback keep");
+    setup.newton.fallback_keep.assign(keep.begin(), keep.end());
+  }
   setup.linear_solver = p.sublist("Linear Solver");
   return setup;
 }

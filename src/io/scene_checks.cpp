@@ -47,6 +47,10 @@ void check_time(const ParameterList& raw) {
   if (!(gamma >= 0.5 && gamma <= 1)) bad("Time/Newmark/gamma", num(gamma), "gamma in [0.5, 1]");
   positive(raw.sublist("Newton"), "Newton/", "eps_d", "eps_d > 0 (m/s)");
   at_least(raw.sublist("Newton"), "Newton/", "max iterations", 1);
+  const auto keep = raw.sublist("Newton").get<Array<double>>("fallback keep");
+  for (Array<double>::size_type k = 0; k < keep.size(); ++k)
+    if (!(keep[k] >= 0 && keep[k] < 1) || (k > 0 && !(keep[k] < keep[k - 1])))
+      bad("Newton/fallback keep", list(keep), "fractions in [0, 1), each below the one before (e.g. [0.7, 0.3])");
   at_least(raw.sublist("Output"), "Output/", "frame every", 1);
   at_least(raw.sublist("Output"), "Output/", "progress every", 0);
 }

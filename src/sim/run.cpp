@@ -152,6 +152,7 @@ void accumulate(RunSummary& s, const StepReport& r) {
   s.projected_retries += r.newton.projected_retries;
   s.exact_hessian_iterations += r.newton.exact_hessian_iterations;
   s.projection_fallbacks += r.newton.projection_fallbacks;
+  s.partial_projections += r.newton.partial_projections;
   s.wolfe_steps += r.newton.wolfe_steps;
   s.wolfe_gradients += r.newton.wolfe_gradients;
 }
@@ -388,7 +389,10 @@ RunSummary run_scene(const Scene& scene, const std::string& dir, const Teuchos::
         << " Newton iterations (the others: CG on the previous factor)\n";
   if (s.exact_hessian_iterations + s.projection_fallbacks > 0)
     log << "  exact Hessian       " << s.exact_hessian_iterations << " of " << s.newton_iterations
-        << " iterations (" << s.projection_fallbacks << " not positive definite: projected)\n";
+        << " iterations (" << s.projection_fallbacks << " not positive definite: projected";
+  if (s.partial_projections > 0)
+    log << ", " << s.partial_projections << " of them keeping part of the contact curvature";
+  if (s.exact_hessian_iterations + s.projection_fallbacks > 0) log << ")\n";
   if (s.projected_retries > 0)
     log << "  steps redone        " << s.projected_retries
         << " (Newton failed with the exact Hessian; the projected one converged)\n";

@@ -27,6 +27,7 @@ struct RunSummary {
   long graph_builds = 0, symbolic_factorizations = 0, numeric_factorizations = 0;
   long projected_retries = 0;  // steps redone with the projected Hessian
   long exact_hessian_iterations = 0, projection_fallbacks = 0;  // Newton/hessian: exact-if-definite
+  long partial_projections = 0;  // fallbacks solved with a partial projection (Newton/fallback keep)
   long wolfe_steps = 0, wolfe_gradients = 0;  // Newton/line search: wolfe (NewtonStats)
   std::vector<std::pair<std::string, double>> term_assembly_s;  // per energy term
   // MPI, MPM bodies in slabs: ranks, particle migrations, slab rebalances and

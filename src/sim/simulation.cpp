@@ -634,6 +634,7 @@ NewtonStats Simulation<dim>::minimize_with_friction(const IncrementalPotential& 
     total.numeric_factorizations += st.numeric_factorizations;
     total.exact_hessian_iterations += st.exact_hessian_iterations;
     total.projection_fallbacks += st.projection_fallbacks;
+    total.partial_projections += st.partial_projections;
     total.wolfe_steps += st.wolfe_steps;
     total.wolfe_gradients += st.wolfe_gradients;
     if (iterations > 1 && st.iterations == 1) break;  // converged at the lagged update

@@ -16,6 +16,14 @@
 
 namespace bfemp {
 
+namespace {
+std::string fmt_g(double v) {
+  char b[32];
+  std::snprintf(b, sizeof b, "%g", v);
+  return b;
+}
+}  // namespace
+
 using View1 = Kokkos::View<double*, MemSpace>;
 using CView1 = Kokkos::View<const double*, MemSpace>;
 
@@ -114,6 +122,7 @@ struct NewtonSolver<dim>::Impl {
 
   // Gradient, Hessian (PSD-projected per stencil when `project`, exact
   // otherwise) and right-hand side at x.
+  double contact_keep = 0.0;
   void assemble(const IncrementalPotential& ip, CView1 x, bool project) {
     auto g = grad;
     auto r = rhs;
@@ -123,6 +132,7 @@ struct NewtonSolver<dim>::Impl {
     dofs.begin_assembly();
     Sink<dim> sink = dofs.sink(ip.h, g, r, ip.prescribed, dxp);
     sink.project = project;
+    sink.contact_keep = project ? contact_keep : 0.0;
     for (const auto* t : dofs.terms()) {
       Kokkos::Timer timer;
       t->assemble(x, sink);
@@ -325,6 +335,7 @@ NewtonStats NewtonSolver<dim>::minimize(const IncrementalPotential& ip, View1 x)
     const double forcing = r0_norm > 0 ? r_norm / r0_norm : 0.0;
     LinearSolveStats ls;
     bool fallback = false;
+    double kept = 0.0;  // contact curvature kept by the fallback's projection
     try {
       ls = m.solver.solve(*m.b, *m.p, forcing > 0 ? forcing : 1e-300);
     } catch (const NotPositiveDefinite&) {
@@ -335,13 +346,30 @@ NewtonStats NewtonSolver<dim>::minimize(const IncrementalPotential& ip, View1 x)
       ++st.numeric_factorizations;  // the one that failed
       fallback = true;
       project = true;
-      timer.reset();
-      m.assemble(ip, x, project);
-      Kokkos::fence();
-      st.assembly_s += timer.seconds();
-      timer.reset();
-      m.p->putScalar(0.0);
-      ls = m.solver.solve(*m.b, *m.p, forcing > 0 ? forcing : 1e-300);
+      // Partial projections first (contact pairs keep a fraction of their
+      // negative curvature), then the full one; a failure of the last throws.
+      const std::vector<double>& keeps = m.params.fallback_keep;
+      for (std::size_t k = 0; k <= keeps.size(); ++k) {
+        m.contact_keep = k < keeps.size() ? keeps[k] : 0.0;
+        timer.reset();
+        m.assemble(ip, x, project);
+        Kokkos::fence();
+        st.assembly_s += timer.seconds();
+        timer.reset();
+        m.p->putScalar(0.0);
+        try {
+          ls = m.solver.solve(*m.b, *m.p, forcing > 0 ? forcing : 1e-300);
+          kept = m.contact_keep;
+          m.contact_keep = 0.0;
+          break;
+        } catch (const NotPositiveDefinite&) {
+          m.contact_keep = 0.0;
+          if (k == keeps.size()) throw;
+          st.solve_s += timer.seconds();
+          ++st.numeric_factorizations;  // the one that failed
+        }
+      }
+      if (kept > 0) ++st.partial_projections;
     }
     if (!project) ++st.exact_hessian_iterations;
     st.linear_iterations += ls.iterations;
@@ -500,10 +528,12 @@ NewtonStats NewtonSolver<dim>::minimize(const IncrementalPotential& ip, View1 x)
     st.line_search_s += timer.seconds();
     st.min_step = std::min(st.min_step, alpha);
     if (m.params.log_iterations && m.comm->getRank() == 0)
-      std::fprintf(stderr, "  newton %3d  |p|/dt %.3e m/s  step %.3e%s  (bound %.3e)  |rhs| %.3e  %s Hessian  linear %d it%s%s\n",
+      std::fprintf(stderr,
+                   "  newton %3d  |p|/dt %.3e m/s  step %.3e%s  (bound %.3e)  |rhs| %.3e  %s Hessian%s  linear %d "
+                   "it%s%s\n",
                    it + 1, p_inf / ip.dt, alpha, wolfe_ended ? " (Wolfe)" : "", 0.9 * a_max, r_norm,
-                   project ? "projected" : "exact", ls.iterations, ls.factorised ? " (factorised)" : "",
-                   fallback ? " after a non-positive pivot" : "");
+                   project ? "projected" : "exact", kept > 0 ? (" (contact keep " + fmt_g(kept) + ")").c_str() : "",
+                   ls.iterations, ls.factorised ? " (factorised)" : "", fallback ? " after a non-positive pivot" : "");
     st.iterations = it + 1;
     if (on_iterate) on_iterate(x);
     if (converged) return st;

@@ -11,8 +11,9 @@
 #include <Teuchos_ParameterList.hpp>
 #include <functional>
 #include <map>
-#include <string>
 #include <memory>
+#include <string>
+#include <vector>
 
 #include "solver/dof_space.hpp"
 #include "solver/energy_term.hpp"
@@ -60,6 +61,13 @@ struct NewtonParams {
   HessianMode hessian = HessianMode::Projected;
   LineSearch line_search = LineSearch::Wolfe;
   bool log_iterations = false;  // one line per iteration on stderr (rank 0)
+  // ExactIfDefinite: when the exact Hessian is indefinite, the contact pairs'
+  // local Hessians keep these fractions of their negative curvature in turn
+  // (Sink::contact_keep), before the full projection. Less stiffness added
+  // than by the projection: where the energy is non-convex along a contact
+  // surface (particles sliding over the facets' edges), the projected Newton
+  // takes short steps and converges linearly.
+  std::vector<double> fallback_keep{0.7, 0.3};
 };
 
 struct NewtonStats {
@@ -73,6 +81,7 @@ struct NewtonStats {
   int projected_retries = 0;       // the step failed with the exact Hessian and was redone projected
   int exact_hessian_iterations = 0; // iterations solved with the exact Hessian
   int projection_fallbacks = 0;     // exact Hessian not positive definite: projected instead
+  int partial_projections = 0;      // of those, solved with a partial projection (fallback_keep > 0)
   int wolfe_steps = 0;              // line searches ended by the strong Wolfe bisection
   int wolfe_gradients = 0;          // gradient evaluations of those bisections (failed ones too)
 };

@@ -46,6 +46,7 @@ const std::vector<Leaf> kLeaves = {
     {"Time/Newmark/gamma", "0.5", Kind::Real},
     {"Newton/eps_d", "1.0e-4", Kind::Real},
     {"Newton/max iterations", "100", Kind::Int},
+    {"Newton/fallback keep", "[0.7, 0.3]", Kind::Vec},
     {"Linear Solver/type", "Cholmod", Kind::Text},
     {"Output/frame every", "1", Kind::Int},
     {"Output/progress every", "1", Kind::Int},
@@ -125,6 +126,7 @@ const std::map<std::string, std::set<Mut>> kMayRun = {
     {"Time/Newmark/gamma", {Mut::Missing}},
     {"Newton/eps_d", {Mut::Missing}},
     {"Newton/max iterations", {Mut::Missing}},
+    {"Newton/fallback keep", {Mut::Missing}},  // [0.7, 0.3]
     {"Linear Solver/type", {Mut::Missing}},  // Cholmod
     {"Output/frame every", {Mut::Missing}},
     {"Output/progress every", {Mut::Zero, Mut::Missing}},

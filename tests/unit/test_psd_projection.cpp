@@ -89,6 +89,38 @@ TYPED_TEST(PsdProjectionTest, KeepsPositiveEigenpairsAndZeroesNegativeOnes) {
   }
 }
 
+// Partial projection (Newton/fallback keep): each negative eigenvalue is
+// scaled by keep, positive eigenpairs stay; keep 0 is the projection bit for
+// bit, and A(keep) is monotone in keep (A(0) - A(keep) PSD, A(keep) - A PSD).
+TYPED_TEST(PsdProjectionTest, PartialProjectionScalesNegativeEigenvalues) {
+  constexpr int n = TypeParam::value;
+  std::mt19937 rng(11 + n);
+  for (int t = 0; t < 20; ++t) {
+    const SquareMat<n> A = random_symmetric<n>(rng);
+    Eigen::SelfAdjointEigenSolver<SquareMat<n>> es(A);
+    const double tol = 1e-12 * A.norm();
+    SquareMat<n> P0 = A, Pz = A;
+    project_psd<n>(P0);
+    project_psd<n>(Pz, 0.0);
+    EXPECT_EQ((P0 - Pz).cwiseAbs().maxCoeff(), 0.0) << "keep 0 must be the projection itself";
+    SquareMat<n> prev = P0;
+    for (const double keep : {0.3, 0.7}) {
+      SquareMat<n> P = A;
+      project_psd<n>(P, keep);
+      for (int k = 0; k < n; ++k) {
+        const double lam = es.eigenvalues()(k);
+        const Eigen::Matrix<double, n, 1> v = es.eigenvectors().col(k);
+        EXPECT_LE((P * v - (lam > 0.0 ? lam : keep * lam) * v).norm(), tol) << "keep " << keep << ", k " << k;
+      }
+      // Less stiff than the stronger projection, stiffer than A.
+      Eigen::SelfAdjointEigenSolver<SquareMat<n>> d1(prev - P), d2(P - A);
+      EXPECT_GE(d1.eigenvalues()(0), -tol);
+      EXPECT_GE(d2.eigenvalues()(0), -tol);
+      prev = P;
+    }
+  }
+}
+
 TYPED_TEST(PsdProjectionTest, IsNearestPsdMatrixInFrobeniusNorm) {
   constexpr int n = TypeParam::value;
   std::mt19937 rng(4 + n);
