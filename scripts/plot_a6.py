@@ -15,36 +15,28 @@ usage: plot_a6.py OUT.png MU=DIR [MU=DIR ...] [--title TEXT]   (needs h5py, nump
 """
 import sys
 
-import h5py
 import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import numpy as np
 
+from h5frames import parse_args, particle_frames
+
 
 def crown_lead(path):
-    f = h5py.File(path + "/bfemp.h5", "r")
-    frames = sorted(k for k in f if k.startswith("frame_"))
-    x0 = f[frames[0]]["particle_positions"][:]
+    frames = particle_frames(path)
+    x0 = frames[0][1]
     crown = (np.abs(x0[:, 0]) < 1.0) & (x0[:, 1] > 9.5)
     t, lead = [], []
-    for k in frames:
-        g = f[k]
-        x = g["particle_positions"][:]
+    for time, x in frames:
         uy = x[crown, 1].mean() - x0[crown, 1].mean()
-        t.append(g.attrs["time"])
-        lead.append(-(uy + g.attrs["time"]))  # crown travel beyond the plate's (m)
+        t.append(time)
+        lead.append(-(uy + time))  # crown travel beyond the plate's (m)
     return np.array(t), np.array(lead)
 
 
 def main():
-    args = sys.argv[1:]
-    title = ""
-    if "--title" in args:
-        k = args.index("--title")
-        title = args[k + 1]
-        del args[k:k + 2]
-    out, runs = args[0], [a.split("=", 1) for a in args[1:]]
+    out, runs, title = parse_args(sys.argv[1:])
     fig, ax = plt.subplots(figsize=(6, 4))
     for mu, d in runs:
         t, lead = crown_lead(d)

@@ -14,38 +14,31 @@ usage: plot_a7.py OUT.png MU=DIR [MU=DIR ...] [--title TEXT]   (needs h5py, nump
 """
 import sys
 
-import h5py
 import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import numpy as np
 
+from h5frames import parse_args, particle_frames
+
 
 def top_rotation(path):
-    f = h5py.File(path + "/bfemp.h5", "r")
-    frames = sorted(k for k in f if k.startswith("frame_"))
-    x0 = f[frames[0]]["particle_positions"][:]
+    frames = particle_frames(path)
+    x0 = frames[0][1]
     top = (np.abs(x0[:, 0]) < 0.25) & (np.abs(x0[:, 1]) < 0.25) & (x0[:, 2] > 0.85)
     top &= np.hypot(x0[:, 0], x0[:, 1]) > 1e-12
     a0 = np.arctan2(x0[top, 1], x0[top, 0])
     t, rot = [], []
-    for k in frames:
-        x = f[k]["particle_positions"][:]
+    for time, x in frames:
         d = np.arctan2(x[top, 1], x[top, 0]) - a0
         d = (d + np.pi) % (2 * np.pi) - np.pi  # each angle in [-pi, pi), as the probe
-        t.append(f[k].attrs["time"])
+        t.append(time)
         rot.append(d.mean())
     return np.array(t), np.array(rot)
 
 
 def main():
-    args = sys.argv[1:]
-    title = ""
-    if "--title" in args:
-        k = args.index("--title")
-        title = args[k + 1]
-        del args[k:k + 2]
-    out, runs = args[0], [a.split("=", 1) for a in args[1:]]
+    out, runs, title = parse_args(sys.argv[1:])
     fig, ax = plt.subplots(figsize=(6.5, 4.2))
     tmax = 0.0
     for mu, d in runs:
