@@ -46,8 +46,11 @@ struct DofSink {
   bool project = true;
   // With project: the fraction of the negative curvature of each contact
   // pair's local Hessian that its projection keeps (project_psd's keep; 0:
-  // the PSD projection). The Newton solver raises it after an indefinite
-  // exact Hessian, so as to add no more stiffness than a factorisation needs.
+  // the PSD projection). After an indefinite exact Hessian the Newton solver
+  // sets it to each of Newton/fallback keep in turn, then 0, so as to add no
+  // more stiffness than the linear solve needs. Like the exact Hessian, a
+  // partial one solved by CG on the previous Cholmod factor is checked for
+  // definiteness only through CG's curvature test, not by a factorisation.
   double contact_keep = 0.0;
   // Counts blocks the graph lacks (when allocated): the DOF space rebuilds
   // the graph and reassembles instead of dropping them.

@@ -49,8 +49,9 @@ void check_time(const ParameterList& raw) {
   at_least(raw.sublist("Newton"), "Newton/", "max iterations", 1);
   const auto keep = raw.sublist("Newton").get<Array<double>>("fallback keep");
   for (Array<double>::size_type k = 0; k < keep.size(); ++k)
-    if (!(keep[k] >= 0 && keep[k] < 1) || (k > 0 && !(keep[k] < keep[k - 1])))
-      bad("Newton/fallback keep", list(keep), "fractions in [0, 1), each below the one before (e.g. [0.7, 0.3])");
+    if (!(keep[k] > 0 && keep[k] < 1) || (k > 0 && !(keep[k] < keep[k - 1])))
+      bad("Newton/fallback keep", list(keep),
+          "fractions in (0, 1), each below the one before (e.g. [0.7, 0.3]; the full projection follows them)");
   at_least(raw.sublist("Output"), "Output/", "frame every", 1);
   at_least(raw.sublist("Output"), "Output/", "progress every", 0);
 }

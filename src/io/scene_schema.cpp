@@ -170,7 +170,7 @@ Teuchos::RCP<const ParameterList> scene_schema() {
   newton.set("fallback keep", Array<double>(tuple<double>(0.7, 0.3)),
              "exact-if-definite, after an indefinite exact Hessian: the fractions of each contact pair's negative "
              "curvature kept (its negative eigenvalues scaled by them), tried in turn before the full PSD "
-             "projection; each in [0, 1), decreasing; [] projects at once. Measured on A7's twist: 0.7, 0.3 halves "
+             "projection; each in (0, 1), decreasing; [] projects at once. Measured on A7's twist: 0.7, 0.3 halves "
              "the Newton iterations of the projection");
   newton.set("log iterations", false,
              "print one line per Newton iteration to stderr: |p|_inf/dt, line-search step and its CCD/inversion "

@@ -121,9 +121,9 @@ struct NewtonSolver<dim>::Impl {
   }
 
   // Gradient, Hessian (PSD-projected per stencil when `project`, exact
-  // otherwise) and right-hand side at x.
-  double contact_keep = 0.0;
-  void assemble(const IncrementalPotential& ip, CView1 x, bool project) {
+  // otherwise; with `project`, contact pairs keep the fraction `contact_keep`
+  // of their negative curvature) and right-hand side at x.
+  void assemble(const IncrementalPotential& ip, CView1 x, bool project, double contact_keep = 0.0) {
     auto g = grad;
     auto r = rhs;
     auto dxp = dx_prescribed;
@@ -350,20 +350,21 @@ NewtonStats NewtonSolver<dim>::minimize(const IncrementalPotential& ip, View1 x)
       // negative curvature), then the full one; a failure of the last throws.
       const std::vector<double>& keeps = m.params.fallback_keep;
       for (std::size_t k = 0; k <= keeps.size(); ++k) {
-        m.contact_keep = k < keeps.size() ? keeps[k] : 0.0;
+        const double keep = k < keeps.size() ? keeps[k] : 0.0;
         timer.reset();
-        m.assemble(ip, x, project);
+        m.assemble(ip, x, project, keep);
         Kokkos::fence();
         st.assembly_s += timer.seconds();
         timer.reset();
         m.p->putScalar(0.0);
         try {
           ls = m.solver.solve(*m.b, *m.p, forcing > 0 ? forcing : 1e-300);
-          kept = m.contact_keep;
-          m.contact_keep = 0.0;
+          kept = keep;
           break;
-        } catch (const NotPositiveDefinite&) {
-          m.contact_keep = 0.0;
+        } catch (const SolverError&) {
+          // A partial projection may be indefinite, or so nearly singular that
+          // the solve is inaccurate: the next, stiffer one. The full
+          // projection's failure is the step's.
           if (k == keeps.size()) throw;
           st.solve_s += timer.seconds();
           ++st.numeric_factorizations;  // the one that failed
