@@ -153,7 +153,7 @@ def scenes(size):
                  for mu in ("0", "0.2", "0.5", "1.0")],
         "bands": [("A7_mu%s" % mu, "slip angle: peak twist of the cube's top centre / pi", a7_top, paper,
                    (lambda v, lo=lo, hi=hi: lo <= v <= hi), text, math.pi)
-                  for mu, paper, lo, hi, text in (("0", "0.1", 0.0, 0.2, "0.1 +- 0.1"),
+                  for mu, paper, lo, hi, text in (("0", "0.1", -0.2, 0.2, "|.| <= 0.2 (0.1 +- 0.1; a frictionless top may turn back)"),
                                                    ("0.2", "0.3", 0.2, 0.4, "0.3 +- 0.1"),
                                                    ("0.5", "0.7", 0.6, 0.8, "0.7 +- 0.1"),
                                                    ("1.0", "no slip (0.9)", 0.8, 1.0, ">= 0.8 (follows to 0.9)"))],
