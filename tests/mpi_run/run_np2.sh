@@ -7,7 +7,9 @@
 # frames on 1 and 2 ranks (particles gathered in scene order), and its 2-rank restart equals
 # the uninterrupted run to solver tolerance (the restart re-cuts the slabs). The colliding
 # rings (MPM + FEM, barrier contact) write the same frames on 1 and 2 ranks, the particles'
-# contact forces included (gathered in scene order). Usage: run_np2.sh BFEMP SOURCE_DIR WORK_DIR
+# contact forces included (gathered in scene order). The 3D twist (A7, coarsened, shortened)
+# with friction on 2 ranks (CG) equals 1 rank (Cholmod): the cube is cut at x = 0 under the
+# shell, so contact pairs and their lagged friction live on both ranks. Usage: run_np2.sh BFEMP SOURCE_DIR WORK_DIR
 set -euo pipefail
 exe=$1; src=$2; work=$3
 rm -rf "$work"; mkdir -p "$work"
@@ -136,4 +138,42 @@ with h5py.File(a + "/bfemp.h5", "r") as fa, h5py.File(b + "/bfemp.h5", "r") as f
         err = np.abs(va - vb).max() / np.abs(va).max()
         assert err < 1e-8, f"{f}/{d}: relative difference {err}"
 print("rings (MPM + FEM contact): 1 and 2 ranks write the same frames, contact forces included")
+PY
+# The 3D twist (A7) with friction mu 0.5, coarsened (dx 0.25: 512 particles; shell element
+# size 0.2), the shell lowered to 1.25 cm above the particles and the schedule shortened
+# (down at 0.5 m/s for 0.1 s, then 2 rad/s about z, to 0.14 s): the shell presses on the
+# cube's top from step 4 and drags it for 4 steps. 1 rank with Cholmod and 2 ranks with CG
+# (slabs cut at x = 0 through the contact patch: a pair on each rank) give the same frames;
+# the friction torque on the cube is a sizeable share of mu x the normal force's moment
+# (0.41 measured; the comparison compares friction, not its absence).
+mo='FEM Bodies/shell/Boundary Conditions/cap'
+tw=(--set 'MPM/grid spacing=0.25' --set 'FEM Bodies/shell/Mesh/element size=0.2'
+    --set 'FEM Bodies/shell/Mesh/center=[0,0,1.45]' --set "$mo/box min=[-1,-1,1.74]"
+    --set "$mo/Motion/a down/duration=0.1" --set "$mo/Motion/b twist/angular velocity=2"
+    --set 'Time/end time=0.14' --set 'Output/frame every=7' --set 'Newton/eps_d=1e-5')
+"${mpi[@]}" -np 1 "$exe" run "$src/inputs/a7_twist.yaml" --output "$work/twist1" "${tw[@]}" > "$work/twist1.log" 2>&1
+"${mpi[@]}" -np 2 "$exe" run "$src/inputs/a7_twist.yaml" --output "$work/twist2" "${tw[@]}" \
+  --set 'Linear Solver/type=CG' --set 'Linear Solver/CG/tolerance=1e-13' > "$work/twist2.log" 2>&1 \
+  || { echo "the twist on 2 ranks failed"; cat "$work/twist2.log"; exit 1; }
+grep -q "cuts at 0 m" "$work/twist2.log" || { echo "the twist's slabs are not cut at x = 0"; cat "$work/twist2.log"; exit 1; }
+/usr/bin/python3 - "$work/twist1" "$work/twist2" <<'PY'
+import sys, h5py, numpy as np
+a, b = sys.argv[1:3]
+mu = 0.5
+with h5py.File(a + "/bfemp.h5", "r") as fa, h5py.File(b + "/bfemp.h5", "r") as fb:
+    fr = sorted(k for k in fa if k.startswith("frame_"))
+    assert fr == sorted(k for k in fb if k.startswith("frame_")) and len(fr) == 3, fr
+    f = fr[-1]
+    p, F = fa[f]["particle_positions"][()], fa[f]["particle_contact_force"][()]
+    pressed = np.abs(F[:, 2]) > 0
+    assert (p[pressed, 0] < 0).any() and (p[pressed, 0] >= 0).any(), "the contact patch is not cut by the slabs"
+    torque = (p[:, 0] * F[:, 1] - p[:, 1] * F[:, 0]).sum()
+    bound = mu * (np.abs(F[:, 2]) * np.hypot(p[:, 0], p[:, 1])).sum()
+    assert torque > 0.25 * bound, f"friction torque {torque} N m against mu |Fz| r {bound}"
+    for d in ("positions", "velocities", "particle_positions", "particle_velocities", "particle_contact_force"):
+        va, vb = fa[f][d][()], fb[f][d][()]
+        # Newton stops at |p|/dt < 1e-5 m/s; measured: 1.2e-8 of the largest value.
+        err = np.abs(va - vb).max() / np.abs(va).max()
+        assert err < 1e-7, f"{f}/{d}: relative difference {err}"
+print(f"twist (friction across ranks): 1 and 2 ranks agree; friction torque {torque:.0f} N m, {torque / bound:.2f} of mu |Fz| r")
 PY
