@@ -11,6 +11,7 @@
 #include <set>
 #include <sstream>
 
+#include "solver/block_cholmod.hpp"
 #include "solver/cholmod_direct.hpp"
 #include "solver/muelu_preconditioner.hpp"
 #include "solver/solver_error.hpp"
@@ -22,7 +23,7 @@ using Teuchos::ParameterList;
 using Teuchos::RCP;
 using Teuchos::rcp;
 
-const char* const kPrecNames[] = {"RELAXATION", "CHEBYSHEV", "RILUK", "SCHWARZ", "MUELU", "NONE"};
+const char* const kPrecNames[] = {"RELAXATION", "CHEBYSHEV", "RILUK", "SCHWARZ", "MUELU", "BLOCK_CHOLMOD", "NONE"};
 
 // Ifpack2 validates only RELAXATION's list; the others ignore unknown keys, so
 // bfemp checks those against the keys each one reads (Ifpack2 13.2 sources).
@@ -113,9 +114,11 @@ Teuchos::RCP<const Teuchos::ParameterList> linear_solver_schema() {
       "preconditioner", "RELAXATION",
       "an Ifpack2 preconditioner (RELAXATION, CHEBYSHEV, RILUK, SCHWARZ), MUELU (algebraic "
       "multigrid on the rigid-body modes of the nodes: the fastest for FEM-only scenes, slow "
-      "where the graph changes every step, as with MPM bodies) or NONE",
+      "where the graph changes every step, as with MPM bodies), BLOCK_CHOLMOD (an exact "
+      "Cholesky factor of each rank's diagonal block: one iteration on 1 rank, the fewest on "
+      "the 3D twist on 2) or NONE",
       Teuchos::tuple<std::string>(kPrecNames[0], kPrecNames[1], kPrecNames[2], kPrecNames[3],
-                                  kPrecNames[4], kPrecNames[5]),
+                                  kPrecNames[4], kPrecNames[5], kPrecNames[6]),
       &cg);
   auto& ifp = cg.sublist("Ifpack2", false,
                          "parameters passed to the Ifpack2 preconditioner (checked by bfemp)");
@@ -155,8 +158,15 @@ struct LinearSolver::Impl {
   bool symbolic_done = false;
   RCP<Prec> prec;
   std::unique_ptr<MueLuPreconditioner> muelu;
+  RCP<BlockCholmod> block;  // BLOCK_CHOLMOD: per graph
   std::string prec_name;
   ParameterList ifpack2;
+  // SCHWARZ with an AMESOS2 subdomain solve: Ifpack2 13.2's Amesos2 wrapper
+  // copies the local matrix's values in initialize(), not in compute(), so
+  // compute() alone would factor the values of set_matrix time (zeros, or an
+  // earlier Newton iteration's). Such a preconditioner is re-initialised
+  // (local copy and symbolic analysis) before every compute().
+  bool reinitialise_each_compute = false;
   double cg_tol = 1e-12;
   bool adaptive = true;
   int cg_max_iters = 2000;
@@ -197,6 +207,9 @@ LinearSolver::LinearSolver(const ParameterList& params, const RCP<const Comm>& c
   impl_->ifpack2 = cg.sublist("Ifpack2");
   if (impl_->prec_name == "SCHWARZ" && !impl_->ifpack2.isParameter("schwarz: combine mode"))
     impl_->ifpack2.set("schwarz: combine mode", "ADD");  // 13.2 default (ZERO) is non-symmetric
+  impl_->reinitialise_each_compute =
+      impl_->prec_name == "SCHWARZ" && impl_->ifpack2.isParameter("schwarz: inner preconditioner name") &&
+      impl_->ifpack2.get<std::string>("schwarz: inner preconditioner name") == "AMESOS2";
   if (kind_ == LinearSolverKind::CG) {
     // Parameters for a preconditioner that is not the chosen one would be
     // ignored: refuse them.
@@ -261,8 +274,11 @@ void LinearSolver::set_matrix(const RCP<const Matrix>& A) {
   m.A = A;
   if (kind_ == LinearSolverKind::CG) {
     m.prec = Teuchos::null;
+    m.block = Teuchos::null;
     if (m.muelu) {
       m.muelu->set_matrix(A);
+    } else if (m.prec_name == "BLOCK_CHOLMOD") {
+      m.block = rcp(new BlockCholmod(A));
     } else if (m.prec_name != "NONE") {
       m.prec = Ifpack2::Factory::create<Tpetra::RowMatrix<double, LO, GO, Node>>(m.prec_name, A);
       try {
@@ -271,7 +287,7 @@ void LinearSolver::set_matrix(const RCP<const Matrix>& A) {
         throw std::invalid_argument("scene sublist 'Linear Solver/CG/Ifpack2' rejected by " +
                                     m.prec_name + ": " + e.what());
       }
-      m.prec->initialize();
+      if (!m.reinitialise_each_compute) m.prec->initialize();  // else at each compute (see Impl)
     }
     return;
   }
@@ -340,7 +356,11 @@ LinearSolveStats LinearSolver::solve(const Vector& b, Vector& x, double forcing)
       throw SolverError(std::string("MueLu set-up failed: ") + e.what());
     }
     M = m.muelu->op();
+  } else if (!m.block.is_null()) {
+    m.block->compute();
+    M = m.block;
   } else if (!m.prec.is_null()) {
+    if (m.reinitialise_each_compute) m.prec->initialize();
     m.prec->compute();
     M = m.prec;
   }
