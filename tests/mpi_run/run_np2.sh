@@ -8,7 +8,7 @@
 # the uninterrupted run to solver tolerance (the restart re-cuts the slabs). The colliding
 # rings (MPM + FEM, barrier contact) write the same frames on 1 and 2 ranks, the particles'
 # contact forces included (gathered in scene order). The 3D twist (A7, coarsened, shortened)
-# with friction on 2 ranks (CG) equals 1 rank (Cholmod): the cube is cut at x = 0 under the
+# with friction on 2 ranks (CG + BLOCK_CHOLMOD) equals 1 rank (Cholmod): the cube is cut at x = 0 under the
 # shell, so contact pairs and their lagged friction live on both ranks. Usage: run_np2.sh BFEMP SOURCE_DIR WORK_DIR
 set -euo pipefail
 exe=$1; src=$2; work=$3
@@ -142,8 +142,9 @@ PY
 # The 3D twist (A7) with friction mu 0.5, coarsened (dx 0.25: 512 particles; shell element
 # size 0.2), the shell lowered to 1.25 cm above the particles and the schedule shortened
 # (down at 0.5 m/s for 0.1 s, then 2 rad/s about z, to 0.14 s): the shell presses on the
-# cube's top from step 4 and drags it for 4 steps. 1 rank with Cholmod and 2 ranks with CG
-# (slabs cut at x = 0 through the contact patch: a pair on each rank) give the same frames;
+# cube's top from step 4 and drags it for 4 steps. 1 rank with Cholmod and 2 ranks with CG +
+# BLOCK_CHOLMOD (slabs cut at x = 0 through the contact patch: a pair on each rank) give the
+# same frames;
 # the friction torque on the cube is a sizeable share of mu x the normal force's moment
 # (0.41 measured; the comparison compares friction, not its absence).
 mo='FEM Bodies/shell/Boundary Conditions/cap'
@@ -153,7 +154,8 @@ tw=(--set 'MPM/grid spacing=0.25' --set 'FEM Bodies/shell/Mesh/element size=0.2'
     --set 'Time/end time=0.14' --set 'Output/frame every=7' --set 'Newton/eps_d=1e-5')
 "${mpi[@]}" -np 1 "$exe" run "$src/inputs/a7_twist.yaml" --output "$work/twist1" "${tw[@]}" > "$work/twist1.log" 2>&1
 "${mpi[@]}" -np 2 "$exe" run "$src/inputs/a7_twist.yaml" --output "$work/twist2" "${tw[@]}" \
-  --set 'Linear Solver/type=CG' --set 'Linear Solver/CG/tolerance=1e-13' > "$work/twist2.log" 2>&1 \
+  --set 'Linear Solver/type=CG' --set 'Linear Solver/CG/tolerance=1e-13' \
+  --set 'Linear Solver/CG/preconditioner=BLOCK_CHOLMOD' > "$work/twist2.log" 2>&1 \
   || { echo "the twist on 2 ranks failed"; cat "$work/twist2.log"; exit 1; }
 grep -q "cuts at 0 m" "$work/twist2.log" || { echo "the twist's slabs are not cut at x = 0"; cat "$work/twist2.log"; exit 1; }
 /usr/bin/python3 - "$work/twist1" "$work/twist2" <<'PY'

@@ -1,0 +1,76 @@
+#!/usr/bin/env bash
+# The 3D twist (VALIDATION A7, inputs/a7_twist.yaml: ci size, 4096 particles,
+# 756 FEM nodes; friction mu 0.5) for its first N steps (default 15: the shell
+# lands on the cube at step 8) on 1 and 2 MPI ranks: 1 rank x 1 thread and
+# 1 x 2 with Cholmod (the default), 2 ranks x 1 thread with CG and each
+# preconditioner in --precs (direct solvers are refused on 2 ranks). Writes
+# the mean per contact step of step_s, assembly_s, solve_s, the Newton and CG
+# iterations from each run's diagnostics.csv, as JSON that perf/compare.py
+# reads (solver = the configuration, threads = ranks x threads):
+#   perf/run_twist_ranks.sh [--build-dir DIR] [--out FILE] [--steps N] [--precs "RELAXATION BLOCK_CHOLMOD"]
+#   python3 perf/compare.py build/perf/twist_ranks.json --baseline perf/baselines/twist_ranks.json \
+#       --fields step_s,assembly_s,solve_s
+# Goal (MPI issue, paper size): 2 ranks >= 1.6x over 1 x 1.
+set -euo pipefail
+repo="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+build_dir="$repo/build"
+out=""
+steps=15
+precs="RELAXATION BLOCK_CHOLMOD"
+while [[ $# -gt 0 ]]; do
+  case "$1" in
+    --build-dir) build_dir="$(cd "$2" && pwd)"; shift 2 ;;
+    --out) out="$2"; shift 2 ;;
+    --steps) steps="$2"; shift 2 ;;
+    --precs) precs="$2"; shift 2 ;;
+    -h|--help) sed -n '2,13p' "${BASH_SOURCE[0]}"; exit 0 ;;
+    *) echo "run_twist_ranks.sh: unknown argument '$1' (see --help)" >&2; exit 2 ;;
+  esac
+done
+[[ -n "$out" ]] || out="$build_dir/perf/twist_ranks.json"
+bin="$build_dir/drivers/bfemp"
+[[ -x "$bin" ]] || { echo "run_twist_ranks.sh: $bin not found; build it first: ninja -C $build_dir bfemp" >&2; exit 2; }
+tmp="$(mktemp -d)"
+trap 'rm -rf "$tmp"' EXIT
+end_time=$(python3 -c "print(($steps + 0.5) * 1e-2)")
+common=(--set "Time/end time=$end_time" --set "Output/frame every=1000000" --set "Output/progress every=5")
+mpi=(mpirun --oversubscribe --allow-run-as-root --bind-to none -x OMP_PROC_BIND=false -x OPENBLAS_NUM_THREADS=1)
+runs=()
+run() {  # name ranks threads [bfemp args...]
+  local name=$1 np=$2 nt=$3; shift 3
+  echo "== twist ci, $name: $np rank(s) x $nt thread(s), $steps steps"
+  "${mpi[@]}" -x OMP_NUM_THREADS="$nt" -np "$np" "$bin" run "$repo/inputs/a7_twist.yaml" --output "$tmp/$name" \
+    "${common[@]}" "$@" > "$tmp/$name.log" 2>&1 \
+    || { cat "$tmp/$name.log" >&2; echo "run_twist_ranks.sh: the run $name failed" >&2; exit 1; }
+  grep -E "Newton iterations|linear iterations|assembly time|linear-solve|wall time" "$tmp/$name.log" || true
+  runs+=("$name:$np:$nt:$tmp/$name/diagnostics.csv")
+}
+run cholmod 1 1
+run cholmod 1 2
+for p in $precs; do
+  run "cg_$p" 2 1 --set 'Linear Solver/type=CG' --set "Linear Solver/CG/preconditioner=$p"
+done
+mkdir -p "$(dirname "$out")"
+python3 - "$out" "$repo" "${runs[@]}" <<'PY'
+import csv, datetime, json, subprocess, sys
+out, repo, runs = sys.argv[1], sys.argv[2], sys.argv[3:]
+def sh(*cmd):
+    try: return subprocess.run(cmd, cwd=repo, capture_output=True, text=True, check=True).stdout.strip()
+    except Exception: return ""
+results = []
+for spec in runs:
+    name, np_, nt, diag = spec.split(":", 3)
+    rows = [r for r in csv.DictReader(open(diag)) if int(r["step"]) > 0 and int(r["contact_pairs"]) > 0]
+    n = len(rows)
+    mean = lambda k: sum(float(r[k]) for r in rows) / n if n else float("nan")
+    results.append({"dim": 3, "size": "twist_ci", "solver": name, "threads": int(np_) * int(nt),
+                    "ranks": int(np_), "threads_per_rank": int(nt), "contact_steps": n,
+                    "step_s": mean("step_s"), "assembly_s": mean("assembly_s"), "solve_s": mean("solve_s"),
+                    "newton_iters": mean("newton_iters"), "linear_iters": mean("linear_iters")})
+    r = results[-1]
+    print(f"  {name} {np_}x{nt}: {n} contact steps, {r['step_s']:.2f} s per step (assembly {r['assembly_s']:.2f}, "
+          f"solve {r['solve_s']:.2f}), {r['newton_iters']:.1f} Newton, {r['linear_iters']:.0f} linear iterations")
+json.dump({"benchmark": "twist_ranks", "date": datetime.datetime.now().astimezone().isoformat(timespec="seconds"),
+           "git": {"commit": sh("git", "rev-parse", "HEAD")}, "results": results}, open(out, "w"), indent=1)
+print(f"run_twist_ranks.sh: wrote {out}")
+PY
