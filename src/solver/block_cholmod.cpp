@@ -9,6 +9,7 @@
 #include <utility>
 #include <vector>
 
+#include "solver/cholmod_views.hpp"
 #include "solver/solver_error.hpp"
 
 namespace bfemp {
@@ -42,21 +43,7 @@ struct BlockCholmod::Impl {
     if (E) cholmod_l_free_dense(&E, &c);
     cholmod_l_finish(&c);
   }
-  cholmod_sparse view() {
-    cholmod_sparse S{};
-    S.nrow = S.ncol = p.size() - 1;
-    S.nzmax = i.size();
-    S.p = p.data();
-    S.i = i.data();
-    S.x = values.data();
-    S.stype = 1;  // upper triangle read; the block is symmetric
-    S.itype = CHOLMOD_LONG;
-    S.xtype = CHOLMOD_REAL;
-    S.dtype = CHOLMOD_DOUBLE;
-    S.sorted = 1;
-    S.packed = 1;
-    return S;
-  }
+  cholmod_sparse view() { return symmetric_csc_view(p, i, values.data()); }
 };
 
 // Once per graph (host): which of A's entries lie in this rank's block, in
@@ -137,14 +124,7 @@ void BlockCholmod::apply(const MultiVec& Xin, MultiVec& Yout, Teuchos::ETransp, 
   auto yv = Yout.getLocalViewDevice(Tpetra::Access::ReadWrite);
   for (std::size_t col = 0; col < Xin.getNumVectors(); ++col) {
     if (n == 0) break;
-    cholmod_dense B{};
-    B.nrow = n;
-    B.ncol = 1;
-    B.nzmax = n;
-    B.d = n;
-    B.x = const_cast<double*>(&xv(0, col));  // LayoutLeft: column col is contiguous
-    B.xtype = CHOLMOD_REAL;
-    B.dtype = CHOLMOD_DOUBLE;
+    cholmod_dense B = dense_column_view(const_cast<double*>(&xv(0, col)), n);  // LayoutLeft: contiguous
     if (!cholmod_l_solve2(CHOLMOD_A, m.L, &B, nullptr, &m.X, nullptr, &m.Y, &m.E, &m.c) || m.c.status != CHOLMOD_OK)
       throw SolverError("block Cholesky preconditioner (BLOCK_CHOLMOD): CHOLMOD solve status " +
                         std::to_string(m.c.status));

@@ -9,6 +9,7 @@
 #include <utility>
 #include <vector>
 
+#include "solver/cholmod_views.hpp"
 #include "solver/solver_error.hpp"
 
 namespace bfemp {
@@ -65,21 +66,8 @@ struct CholmodDirect::Impl {
     cholmod_l_finish(&c);
   }
 
-  cholmod_sparse view() {
-    auto lcl = A->getLocalMatrixDevice();
-    cholmod_sparse S{};
-    S.nrow = S.ncol = static_cast<std::size_t>(lcl.numRows());
-    S.nzmax = i.size();
-    S.p = p.data();
-    S.i = i.data();
-    S.x = lcl.values.data();  // the matrix's own values, not a copy
-    S.stype = 1;
-    S.itype = CHOLMOD_LONG;
-    S.xtype = CHOLMOD_REAL;
-    S.dtype = CHOLMOD_DOUBLE;
-    S.sorted = 1;
-    S.packed = 1;
-    return S;
+  cholmod_sparse view() {  // the matrix's own values, not a copy
+    return symmetric_csc_view(p, i, A->getLocalMatrixDevice().values.data());
   }
 };
 
@@ -147,14 +135,7 @@ static bool cg_on_old_factor(CholmodDirect::Reuse reuse, cholmod_common& c, chol
   if (bn == 0.0) return true;
   const double stop = reuse.tolerance * bn;
   auto precondition = [&]() {  // z = (L L^T)^-1 r
-    cholmod_dense R{};
-    R.nrow = n;
-    R.ncol = 1;
-    R.nzmax = n;
-    R.d = n;
-    R.x = r.data();
-    R.xtype = CHOLMOD_REAL;
-    R.dtype = CHOLMOD_DOUBLE;
+    cholmod_dense R = dense_column_view(r.data(), n);
     if (!cholmod_l_solve2(CHOLMOD_A, L, &R, nullptr, &X, nullptr, &Y, &E, &c) || c.status != CHOLMOD_OK) return false;
     const double* xs = static_cast<const double*>(X->x);
     Kokkos::parallel_for("cholmod_cg_z", Range(0, n), KOKKOS_LAMBDA(const std::size_t k) { z(k) = xs[k]; });
@@ -259,14 +240,7 @@ CholmodDirect::Result CholmodDirect::solve(const Vector& b, Vector& x) {
   if (keep) std::swap(m.L, m.spare);
   m.factor_ok = true;
   auto bv = b.getLocalViewDevice(Tpetra::Access::ReadOnly);
-  cholmod_dense B{};
-  B.nrow = S.nrow;
-  B.ncol = 1;
-  B.nzmax = S.nrow;
-  B.d = S.nrow;
-  B.x = const_cast<double*>(bv.data());
-  B.xtype = CHOLMOD_REAL;
-  B.dtype = CHOLMOD_DOUBLE;
+  cholmod_dense B = dense_column_view(const_cast<double*>(bv.data()), S.nrow);
   if (!cholmod_l_solve2(CHOLMOD_A, m.L, &B, nullptr, &m.X, nullptr, &m.Y, &m.E, &m.c) || m.c.status != CHOLMOD_OK)
     throw SolverError("Cholmod solve failed: " + status_name(m.c.status));
   auto xv = x.getLocalViewDevice(Tpetra::Access::OverwriteAll);
