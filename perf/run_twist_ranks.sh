@@ -45,8 +45,8 @@ run() {  # name ranks threads [bfemp args...]
   grep -E "Newton iterations|linear iterations|assembly time|linear-solve|wall time" "$tmp/$name.log" || true
   runs+=("$name:$np:$nt:$tmp/$name/diagnostics.csv")
 }
-run cholmod 1 1
-run cholmod 1 2
+run cholmod_1x1 1 1
+run cholmod_1x2 1 2
 for p in $precs; do
   run "cg_$p" 2 1 --set 'Linear Solver/type=CG' --set "Linear Solver/CG/preconditioner=$p"
 done
