@@ -53,23 +53,19 @@ for t in $threads; do
 done
 mkdir -p "$(dirname "$out")"
 python3 - "$out" "$repo" "${runs[@]}" <<'PY'
-import csv, datetime, json, re, subprocess, sys
+import re, sys
 out, repo, runs = sys.argv[1], sys.argv[2], sys.argv[3:]
-def sh(*cmd):
-    try: return subprocess.run(cmd, cwd=repo, capture_output=True, text=True, check=True).stdout.strip()
-    except Exception: return ""
+sys.path.insert(0, repo + "/perf")
+from scene_stats import contact_step_means, write_results
 results = []
 for spec in runs:
     t, diag, mem, log = spec.split(":", 3)
-    rows = [r for r in csv.DictReader(open(diag)) if int(r["step"]) > 0 and int(r["contact_pairs"]) > 0]
-    n = len(rows)
-    mean = lambda k: sum(float(r[k]) for r in rows) / n if n else float("nan")
+    n, m = contact_step_means(diag, ("step_s", "assembly_s", "solve_s", "newton_iters"))
     text = open(log).read()
     gb = re.search(r"graph builds\s+(\d+)", text)
     parts = re.search(r"FEM: (\d+) nodes.*MPM: (\d+) particles", text)
     results.append({"dim": 2, "size": "rings_paper", "solver": "Cholmod", "threads": int(t),
-                    "contact_steps": n, "step_s": mean("step_s"), "assembly_s": mean("assembly_s"),
-                    "solve_s": mean("solve_s"), "newton_iters": mean("newton_iters"),
+                    "contact_steps": n, **m,
                     "graph_builds": int(gb.group(1)) if gb else None,
                     "fem_nodes": int(parts.group(1)) if parts else None,
                     "particles": int(parts.group(2)) if parts else None,
@@ -78,7 +74,6 @@ for spec in runs:
     print(f"  {t} thread(s): {n} contact steps, {r['step_s']:.3f} s per step (assembly {r['assembly_s']:.3f}, "
           f"solve {r['solve_s']:.3f}), {r['newton_iters']:.1f} Newton iterations, peak {r['peak_rss_mib']} MiB"
           f" (goal <= 0.25 s per step at 2 threads)")
-json.dump({"benchmark": "scenes", "date": datetime.datetime.now().astimezone().isoformat(timespec="seconds"),
-           "git": {"commit": sh("git", "rev-parse", "HEAD")}, "results": results}, open(out, "w"), indent=1)
+write_results(out, "scenes", repo, results)
 print(f"run_scenes.sh: wrote {out}")
 PY

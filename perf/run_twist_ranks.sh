@@ -52,25 +52,19 @@ for p in $precs; do
 done
 mkdir -p "$(dirname "$out")"
 python3 - "$out" "$repo" "${runs[@]}" <<'PY'
-import csv, datetime, json, subprocess, sys
+import sys
 out, repo, runs = sys.argv[1], sys.argv[2], sys.argv[3:]
-def sh(*cmd):
-    try: return subprocess.run(cmd, cwd=repo, capture_output=True, text=True, check=True).stdout.strip()
-    except Exception: return ""
+sys.path.insert(0, repo + "/perf")
+from scene_stats import contact_step_means, write_results
 results = []
 for spec in runs:
     name, np_, nt, diag = spec.split(":", 3)
-    rows = [r for r in csv.DictReader(open(diag)) if int(r["step"]) > 0 and int(r["contact_pairs"]) > 0]
-    n = len(rows)
-    mean = lambda k: sum(float(r[k]) for r in rows) / n if n else float("nan")
+    n, m = contact_step_means(diag, ("step_s", "assembly_s", "solve_s", "newton_iters", "linear_iters"))
     results.append({"dim": 3, "size": "twist_ci", "solver": name, "threads": int(np_) * int(nt),
-                    "ranks": int(np_), "threads_per_rank": int(nt), "contact_steps": n,
-                    "step_s": mean("step_s"), "assembly_s": mean("assembly_s"), "solve_s": mean("solve_s"),
-                    "newton_iters": mean("newton_iters"), "linear_iters": mean("linear_iters")})
+                    "ranks": int(np_), "threads_per_rank": int(nt), "contact_steps": n, **m})
     r = results[-1]
     print(f"  {name} {np_}x{nt}: {n} contact steps, {r['step_s']:.2f} s per step (assembly {r['assembly_s']:.2f}, "
           f"solve {r['solve_s']:.2f}), {r['newton_iters']:.1f} Newton, {r['linear_iters']:.0f} linear iterations")
-json.dump({"benchmark": "twist_ranks", "date": datetime.datetime.now().astimezone().isoformat(timespec="seconds"),
-           "git": {"commit": sh("git", "rev-parse", "HEAD")}, "results": results}, open(out, "w"), indent=1)
+write_results(out, "twist_ranks", repo, results)
 print(f"run_twist_ranks.sh: wrote {out}")
 PY
