@@ -158,9 +158,9 @@ Teuchos::RCP<const ParameterList> scene_schema() {
   newton.set("eps_d", 1e-6, "stop when |p|_inf / dt < eps_d (m/s)");
   newton.set("max iterations", 200, "iteration cap per step; reaching it is an error");
   choice(newton, "hessian", "exact-if-definite",
-         "exact-if-definite: the exact Hessian whenever Cholmod factorises it, else the projected one "
-         "(other linear solvers: always projected); projected: PSD-projected stencil Hessians (paper "
-         "Algorithm 2)",
+         "exact-if-definite: the exact Hessian whenever Cholmod (or CG + BLOCK_CHOLMOD) finds it positive "
+         "definite, else the projected one (other linear solvers: always projected); projected: "
+         "PSD-projected stencil Hessians (paper Algorithm 2)",
          tuple<std::string>("projected", "exact-if-definite"));
   choice(newton, "line search", "wolfe",
          "wolfe: when the first step raises the energy, bisect on the sign of the directional derivative "

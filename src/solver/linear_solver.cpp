@@ -228,6 +228,10 @@ LinearSolver::LinearSolver(const ParameterList& params, const RCP<const Comm>& c
     check_ifpack2_keys(impl_->prec_name, impl_->ifpack2);
 }
 
+bool LinearSolver::detects_indefinite() const {
+  return kind_ == LinearSolverKind::Cholmod || (kind_ == LinearSolverKind::CG && impl_->prec_name == "BLOCK_CHOLMOD");
+}
+
 bool LinearSolver::wants_near_null_space() const { return impl_->muelu != nullptr; }
 
 int LinearSolver::near_null_space_every() const { return impl_->muelu_rebuild_every; }
@@ -381,6 +385,13 @@ LinearSolveStats LinearSolver::solve(const Vector& b, Vector& x, double forcing)
   Belos::ReturnType ret;
   try {
     ret = cg.solve();
+  } catch (const Belos::CGIterateFailure& e) {
+    // p^T A p <= 0 for a direction p != 0: with an SPD preconditioner (the
+    // block Cholesky factors) this proves A is not positive definite.
+    if (!m.block.is_null())
+      throw NotPositiveDefinite(std::string("CG met p^T A p <= 0 under BLOCK_CHOLMOD: the matrix is not positive "
+                                            "definite (") + e.what() + ")");
+    throw SolverError(std::string("CG failed (matrix not positive definite?): ") + e.what());
   } catch (const std::exception& e) {
     throw SolverError(std::string("CG failed (matrix not positive definite?): ") + e.what());
   }

@@ -61,6 +61,12 @@ class LinearSolver {
   int preconditioner_setups() const;
 
   LinearSolverKind kind() const { return kind_; }
+  // Whether a solve with an indefinite matrix throws NotPositiveDefinite (so
+  // Newton may try the exact Hessian first): Cholmod (a non-positive pivot),
+  // and CG with BLOCK_CHOLMOD (a block's pivot, or p^T A p <= 0 met by CG
+  // under that SPD preconditioner). CG may converge on an indefinite matrix
+  // without meeting negative curvature; the line search still demands descent.
+  bool detects_indefinite() const;
   // The tolerance of a solve with forcing 0 ('CG/tolerance'; 0 for direct).
   double tightest_tolerance() const;
   std::string describe() const;

@@ -284,7 +284,7 @@ NewtonStats NewtonSolver<dim>::minimize(const IncrementalPotential& ip, View1 x)
   auto trial = m.trial;
   double r0_norm = 0;
   const bool try_exact =
-      m.params.hessian == HessianMode::ExactIfDefinite && m.solver.kind() == LinearSolverKind::Cholmod;
+      m.params.hessian == HessianMode::ExactIfDefinite && m.solver.detects_indefinite();
   if (m.modes_stale || ++m.solves_since_modes >= m.solver.near_null_space_every()) m.refresh_modes(x);
   for (int it = 0; it < m.params.max_iterations; ++it) {
     // Remaining offset of the prescribed DOFs.

@@ -23,6 +23,8 @@
 
 #include <cmath>
 #include <iostream>
+#include <string>
+#include <vector>
 
 #include "common/fem_fixtures.hpp"
 #include "io/scene.hpp"
@@ -39,9 +41,11 @@ struct RingsRun {
   std::vector<double> x;  // FEM nodes, then particles
 };
 
-RingsRun run(const std::string& hessian, int steps) {
-  const Scene scene = load_scene(scene_file, {"MPM Bodies/left/center=[-4.01, 0.0]",
-                                               "FEM Bodies/right/Mesh/center=[4.01, 0.0]", "Newton/hessian=" + hessian});
+RingsRun run(const std::string& hessian, int steps, std::vector<std::string> sets = {}) {
+  for (const char* s : {"MPM Bodies/left/center=[-4.01, 0.0]", "FEM Bodies/right/Mesh/center=[4.01, 0.0]"})
+    sets.emplace_back(s);
+  sets.push_back("Newton/hessian=" + hessian);
+  const Scene scene = load_scene(scene_file, sets);
   Simulation<2> sim(build_setup<2>(scene), fixtures::comm());
   RingsRun r;
   sim.newton().on_iterate = [&](Kokkos::View<const double*, MemSpace> x) {
@@ -98,7 +102,7 @@ TEST(NewtonHessian, ExactIfDefiniteReachesTheProjectedSolutionInFewerIterations)
             << eps_d * dt << " m)\n";
 }
 
-// With a linear solver that cannot certify definiteness (CG), the exact mode
+// With a linear solver that cannot certify definiteness (CG + RELAXATION), the exact mode
 // uses the projected Hessian: the same run as 'projected', iteration for
 // iteration.
 TEST(NewtonHessian, OtherSolversKeepTheProjection) {
@@ -111,4 +115,29 @@ TEST(NewtonHessian, OtherSolversKeepTheProjection) {
     EXPECT_EQ(s.newton.projection_fallbacks, 0);
     EXPECT_GT(s.newton.iterations, 0);
   }
+}
+
+// CG + BLOCK_CHOLMOD certifies definiteness as Cholmod does (a block's
+// non-positive pivot, or CG's p^T A p <= 0 under that SPD preconditioner; on
+// one rank the block is the whole matrix): the exact mode runs the exact
+// Hessian, falls back at the impacts, and reaches Cholmod's solution.
+TEST(NewtonHessian, BlockCholmodCertifiesDefinitenessAsCholmodDoes) {
+  const Scene scene = load_scene(scene_file);
+  const double dt = scene.params.sublist("Time").get<double>("dt");
+  const double eps_d = scene.params.sublist("Newton").get<double>("eps_d");
+  const int steps = 10;
+  const RingsRun chol = run("exact-if-definite", steps);
+  const RingsRun block = run("exact-if-definite", steps,
+                             {"Linear Solver/type=CG", "Linear Solver/CG/preconditioner=BLOCK_CHOLMOD"});
+  ASSERT_EQ(chol.x.size(), block.x.size());
+  double dx = 0;
+  for (std::size_t i = 0; i < chol.x.size(); ++i) dx = std::max(dx, std::abs(chol.x[i] - block.x[i]));
+  EXPECT_LT(dx, 10 * eps_d * dt * steps);
+  EXPECT_GT(block.exact, block.iterations / 2);
+  EXPECT_GT(block.fallbacks, 0) << "the impacts' indefinite exact Hessians were not detected";
+  EXPECT_EQ(block.exact + block.fallbacks, block.iterations);
+  EXPECT_EQ(block.inside, 0);
+  std::cout << "rings impact, " << steps << " steps, exact-if-definite: Cholmod " << chol.iterations
+            << " Newton iterations (" << chol.fallbacks << " fallbacks); CG + BLOCK_CHOLMOD " << block.iterations
+            << " (" << block.fallbacks << "); max |dx| " << dx << " m\n";
 }
