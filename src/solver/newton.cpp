@@ -343,7 +343,7 @@ NewtonStats NewtonSolver<dim>::minimize(const IncrementalPotential& ip, View1 x)
       // The exact Hessian is indefinite here: the projected one for this iteration.
       st.solve_s += timer.seconds();
       ++st.projection_fallbacks;
-      ++st.numeric_factorizations;  // the one that failed
+      if (m.solver.kind() != LinearSolverKind::CG) ++st.numeric_factorizations;  // the one that failed
       fallback = true;
       project = true;
       // Partial projections first (contact pairs keep a fraction of their
@@ -367,7 +367,7 @@ NewtonStats NewtonSolver<dim>::minimize(const IncrementalPotential& ip, View1 x)
           // projection's failure is the step's.
           if (k == keeps.size()) throw;
           st.solve_s += timer.seconds();
-          ++st.numeric_factorizations;  // the one that failed
+          if (m.solver.kind() != LinearSolverKind::CG) ++st.numeric_factorizations;  // the one that failed
         }
       }
       if (kept > 0) ++st.partial_projections;
