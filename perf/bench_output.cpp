@@ -11,9 +11,21 @@
 //             the serial HDF5 API (the file bfemp writes today);
 //   mpio_coll parallel HDF5 (H5Pset_fapl_mpio), every rank writes its hyperslab
 //             of each dataset with a collective transfer;
-//   mpio_ind  the same with independent transfers.
+//   mpio_ind  the same with independent transfers;
+//   bfemp     what `bfemp run` does on R ranks (src/sim/run.cpp): the ranks
+//             hold their particles as a slab cut leaves them (here rank r the
+//             ids = r mod P, the worst case: (P-1)/P of them change rank),
+//             particles_in_id_block redistributes every particle field into
+//             contiguous id blocks, and Hdf5FrameWriter (MPI-IO, independent
+//             transfers) writes each rank's block of rows. Its "stress" is F
+//             and its von Mises and J the mass and volume (same bytes);
+//   bfemp_gather what `bfemp run` did before (up to 9758db7): the same
+//             particles gathered whole to rank 0 (gather_particles), which
+//             writes them with the serial Hdf5FrameWriter.
 // The file is written under --dir (default /tmp) and removed afterwards.
 //   mpirun -np P bench_output [--particles 1000000] [--repeats 3] [--dir /tmp] [--out output.json]
+#include <Kokkos_Core.hpp>
+#include <Teuchos_DefaultMpiComm.hpp>
 #include <hdf5.h>
 #include <mpi.h>
 
@@ -26,6 +38,9 @@
 #include <stdexcept>
 #include <string>
 #include <vector>
+
+#include "io/hdf5_frames.hpp"
+#include "mpm/particle_distribution.hpp"
 
 namespace {
 
@@ -166,14 +181,71 @@ double write_mpio(const std::string& path, long long N, int rank, int P, bool co
   return seconds_since(t0);
 }
 
-// Rank 0 reads the file back and checks a few values of every field.
-bool verify(const std::string& path, long long N) {
+double write_bfemp(const std::string& path, long long N, int rank, int P, bool gather) {
+  using namespace bfemp;
+  const Teuchos::MpiComm<int> comm(MPI_COMM_WORLD);
+  const long long mine = N / P + (rank < N % P ? 1 : 0);
+  Particles<3> p = allocate_particles<3>(mine);
+  Kokkos::View<long long*, MemSpace> ids("ids", mine);
+  Kokkos::parallel_for(
+      "bench_output_particles", Kokkos::RangePolicy<ExecSpace>(0, mine), KOKKOS_LAMBDA(const long long k) {
+        const long long q = rank + k * P;
+        const double base = 1e-3 * q;
+        ids(k) = q;
+        for (int c = 0; c < 3; ++c) {
+          p.x(k, c) = base + c;
+          p.v(k, c) = base + c + 10;
+          for (int d = 0; d < 3; ++d) p.F(k, c, d) = base + 3 * c + d + 20;
+        }
+        p.mass(k) = base + 30;
+        p.volume0(k) = base + 40;
+        p.body(k) = static_cast<int>(q % 7);
+      });
+  Kokkos::fence();
+  MPI_Barrier(MPI_COMM_WORLD);
+  const auto t0 = std::chrono::steady_clock::now();
+  const Particles<3> b = gather ? gather_particles(p, ids, N, comm) : particles_in_id_block(p, ids, N, comm);
+  if (gather && rank != 0) {  // rank 0 writes alone
+    MPI_Barrier(MPI_COMM_WORLD);
+    return seconds_since(t0);
+  }
+  const auto lo = static_cast<std::size_t>(gather ? 0 : id_block_begin(N, rank, P)), n = b.size(),
+             total = static_cast<std::size_t>(N);
+  Hdf5FrameWriter w(path, gather ? MPI_COMM_NULL : MPI_COMM_WORLD);
+  auto x = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), b.x);
+  auto v = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), b.v);
+  auto F = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), b.F);
+  auto m = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), b.mass);
+  auto V = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), b.volume0);
+  auto body = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), b.body);
+  const std::vector<long long> body64(body.data(), body.data() + n);
+  // (In frame group 0, where verify() looks for them.)
+  w.begin_frame(0, 0.0, 0);
+  w.write_rows("particle_positions", x.data(), n, lo, total, 3);
+  w.write_rows("particle_velocities", v.data(), n, lo, total, 3);
+  w.write_rows("particle_stress", F.data(), n, lo, total, 9);
+  w.write_rows("particle_von_mises", m.data(), n, lo, total, 1);
+  w.write_rows("particle_J", V.data(), n, lo, total, 1);
+  w.write_rows("particle_body", body64.data(), n, lo, total, 1);
+  w.end_frame();
+  w.close();
+  MPI_Barrier(MPI_COMM_WORLD);
+  return seconds_since(t0);
+}
+
+// Rank 0 reads the file back and checks a few values of every field (the
+// datasets in the root group, or in group `group`).
+bool verify(const std::string& path, long long N, const std::string& group = "") {
   hid_t file = H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
   if (file < 0) return false;
   bool ok = true;
   for (int fi = 0; fi < 6 && ok; ++fi) {
     const Field& f = kFields[fi];
-    hid_t d = H5Dopen2(file, f.name, H5P_DEFAULT);
+    hid_t d = H5Dopen2(file, (group + f.name).c_str(), H5P_DEFAULT);
+    if (d < 0) {
+      ok = false;
+      break;
+    }
     if (f.integer) {
       std::vector<long long> v(N);
       ok = H5Dread(d, H5T_NATIVE_LLONG, H5S_ALL, H5S_ALL, H5P_DEFAULT, v.data()) >= 0;
@@ -194,6 +266,7 @@ bool verify(const std::string& path, long long N) {
 
 int main(int argc, char** argv) {
   MPI_Init(&argc, &argv);
+  Kokkos::initialize(argc, argv);
   int rank = 0, P = 1;
   MPI_Comm_rank(MPI_COMM_WORLD, &rank);
   MPI_Comm_size(MPI_COMM_WORLD, &P);
@@ -212,15 +285,17 @@ int main(int argc, char** argv) {
   std::string rows;
   int code = 0;
   try {
-    for (const char* s : {"gather", "mpio_coll", "mpio_ind"}) {
+    for (const char* s : {"gather", "mpio_coll", "mpio_ind", "bfemp", "bfemp_gather"}) {
       double best = 1e300;
+      const std::string w = s;
       for (int r = 0; r < repeats; ++r) {
-        const std::string w = s;
-        const double t = w == "gather" ? write_gather(path, N, rank, P) : write_mpio(path, N, rank, P, w == "mpio_coll");
+        const double t = w == "gather"  ? write_gather(path, N, rank, P)
+                         : w == "bfemp" || w == "bfemp_gather" ? write_bfemp(path, N, rank, P, w != "bfemp")
+                                        : write_mpio(path, N, rank, P, w == "mpio_coll");
         best = std::min(best, t);
       }
       bool ok = true;
-      if (rank == 0) ok = verify(path, N);
+      if (rank == 0) ok = verify(path, N, w.rfind("bfemp", 0) == 0 ? bfemp::Hdf5FrameWriter::frame_group_name(0) + "/" : "");
       if (rank == 0) {
         std::remove(path.c_str());
         std::printf("%-10s %d rank(s), %lld particles: %.3f s per frame (%.0f MB/s)%s\n", s, P, N, best,
@@ -243,6 +318,7 @@ int main(int argc, char** argv) {
     f << "{\n  \"benchmark\": \"output_frame\",\n  \"bytes_per_particle\": 144,\n  \"results\": [\n" << rows
       << "\n  ]\n}\n";
   }
+  Kokkos::finalize();
   MPI_Finalize();
   return code;
 }

@@ -5,12 +5,14 @@
 # 1 x 2 with Cholmod (the default), 2 ranks x 1 thread with CG and each
 # preconditioner in --precs (direct solvers are refused on 2 ranks). Writes
 # the mean per contact step of step_s, assembly_s, solve_s, the Newton and CG
-# iterations from each run's diagnostics.csv, as JSON that perf/compare.py
-# reads (solver = the configuration, threads = ranks x threads):
+# iterations from each run's diagnostics.csv, and from the run's summary the
+# share of the whole run's step time spent in MPI exchanges (DOF export and
+# import, particle migration: comm_share) and in output, as JSON that
+# perf/compare.py reads (solver = the configuration, threads = ranks x threads):
 #   perf/run_twist_ranks.sh [--build-dir DIR] [--out FILE] [--steps N] [--precs "RELAXATION BLOCK_CHOLMOD"]
 #   python3 perf/compare.py build/perf/twist_ranks.json --baseline perf/baselines/twist_ranks.json \
 #       --fields step_s,assembly_s,solve_s
-# Goal (MPI issue, paper size): 2 ranks >= 1.6x over 1 x 1.
+# Goals (MPI issue, paper size): 2 ranks >= 1.6x over 1 x 1; comm_share <= 0.1.
 set -euo pipefail
 repo="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 build_dir="$repo/build"
@@ -42,8 +44,8 @@ run() {  # name ranks threads [bfemp args...]
   "${mpi[@]}" -x OMP_NUM_THREADS="$nt" -np "$np" "$bin" run "$repo/inputs/a7_twist.yaml" --output "$tmp/$name" \
     "${common[@]}" "$@" > "$tmp/$name.log" 2>&1 \
     || { cat "$tmp/$name.log" >&2; echo "run_twist_ranks.sh: the run $name failed" >&2; exit 1; }
-  grep -E "Newton iterations|linear iterations|assembly time|linear-solve|wall time" "$tmp/$name.log" || true
-  runs+=("$name:$np:$nt:$tmp/$name/diagnostics.csv")
+  grep -E "Newton iterations|linear iterations|assembly time|linear-solve|MPI exchanges|output time|wall time" "$tmp/$name.log" || true
+  runs+=("$name:$np:$nt:$tmp/$name.log:$tmp/$name/diagnostics.csv")
 }
 run cholmod_1x1 1 1
 run cholmod_1x2 1 2
@@ -52,19 +54,30 @@ for p in $precs; do
 done
 mkdir -p "$(dirname "$out")"
 python3 - "$out" "$repo" "${runs[@]}" <<'PY'
-import sys
+import csv, re, sys
 out, repo, runs = sys.argv[1], sys.argv[2], sys.argv[3:]
 sys.path.insert(0, repo + "/perf")
 from scene_stats import contact_step_means, write_results
 results = []
 for spec in runs:
-    name, np_, nt, diag = spec.split(":", 3)
+    name, np_, nt, log, diag = spec.split(":", 4)
     n, m = contact_step_means(diag, ("step_s", "assembly_s", "solve_s", "newton_iters", "linear_iters"))
+    # Whole-run totals from the summary (rank 0 prints the slowest rank's).
+    text = open(log).read()
+    ex = re.search(r"MPI exchanges\s+([0-9.eE+-]+) s DOF export/import \(within the times above; ([0-9.eE+-]+) MB sent\), "
+                   r"([0-9.eE+-]+) s particle migration", text)
+    outp = re.search(r"output time\s+([0-9.eE+-]+) s", text)
+    steps_total = sum(float(r["step_s"]) for r in csv.DictReader(open(diag)))
+    exchange, exchange_mb, migration = (float(ex.group(i)) for i in (1, 2, 3)) if ex else (0.0, 0.0, 0.0)
     results.append({"dim": 3, "size": "twist_ci", "solver": name, "threads": int(np_) * int(nt),
-                    "ranks": int(np_), "threads_per_rank": int(nt), "contact_steps": n, **m})
+                    "ranks": int(np_), "threads_per_rank": int(nt), "contact_steps": n, **m,
+                    "run_step_s": steps_total, "exchange_s": exchange, "exchange_mb": exchange_mb, "migration_s": migration,
+                    "comm_share": (exchange + migration) / steps_total if steps_total > 0 else float("nan"),
+                    "output_s": float(outp.group(1)) if outp else float("nan")})
     r = results[-1]
     print(f"  {name} {np_}x{nt}: {n} contact steps, {r['step_s']:.2f} s per step (assembly {r['assembly_s']:.2f}, "
-          f"solve {r['solve_s']:.2f}), {r['newton_iters']:.1f} Newton, {r['linear_iters']:.0f} linear iterations")
+          f"solve {r['solve_s']:.2f}), {r['newton_iters']:.1f} Newton, {r['linear_iters']:.0f} linear iterations; "
+          f"MPI exchanges {100 * r['comm_share']:.1f} % of the step time, output {r['output_s']:.2f} s")
 write_results(out, "twist_ranks", repo, results)
 print(f"run_twist_ranks.sh: wrote {out}")
 PY

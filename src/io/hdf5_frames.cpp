@@ -64,8 +64,9 @@ class Handle {
   herr_t (*closer_)(hid_t);
 };
 
-// File access without HDF5 file locking (see the header).
-hid_t make_fapl(const std::string& file) {
+// File access without HDF5 file locking (see the header), through MPI-IO on
+// `comm` unless it is MPI_COMM_NULL.
+hid_t make_fapl(const std::string& file, MPI_Comm comm = MPI_COMM_NULL) {
   const hid_t fapl = check(H5Pcreate(H5P_FILE_ACCESS), file, "cannot create file access list");
 #if H5_VERSION_GE(1, 10, 7)
   if (H5Pset_file_locking(fapl, 0, 1) < 0) {
@@ -73,7 +74,31 @@ hid_t make_fapl(const std::string& file) {
     fail(file, "cannot disable file locking");
   }
 #endif
+  if (comm != MPI_COMM_NULL) {
+#ifdef H5_HAVE_PARALLEL
+    if (H5Pset_fapl_mpio(fapl, comm, MPI_INFO_NULL) < 0) {
+      H5Pclose(fapl);
+      fail(file, "cannot select the MPI-IO file driver");
+    }
+#else
+    H5Pclose(fapl);
+    throw std::runtime_error("HDF5 file '" + file +
+                             "': this HDF5 library has no MPI-IO driver; an MPI run needs parallel HDF5 "
+                             "(libhdf5-openmpi-dev)");
+#endif
+  }
   return fapl;
+}
+
+// comm when it has more than one rank, else MPI_COMM_NULL (the serial driver).
+MPI_Comm parallel_comm(MPI_Comm comm, int& rank) {
+  rank = 0;
+  if (comm == MPI_COMM_NULL) return comm;
+  int size = 1;
+  MPI_Comm_size(comm, &size);
+  if (size <= 1) return MPI_COMM_NULL;
+  MPI_Comm_rank(comm, &rank);
+  return comm;
 }
 
 void write_scalar_attribute(hid_t loc, const char* name, hid_t file_type, hid_t mem_type,
@@ -124,16 +149,18 @@ std::string Hdf5FrameWriter::frame_group_name(int index) {
   return buf;
 }
 
-Hdf5FrameWriter::Hdf5FrameWriter(const std::string& path) : path_(path) {
+Hdf5FrameWriter::Hdf5FrameWriter(const std::string& path, MPI_Comm comm)
+    : path_(path), comm_(parallel_comm(comm, rank_)) {
   QuietErrors quiet;
-  Handle fapl(make_fapl(path_), H5Pclose);
+  Handle fapl(make_fapl(path_, comm_), H5Pclose);
   file_ = check(H5Fcreate(path_.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, fapl.get()), path_,
                 "cannot create file");
 }
 
-Hdf5FrameWriter::Hdf5FrameWriter(const std::string& path, int keep_frames) : path_(path) {
+Hdf5FrameWriter::Hdf5FrameWriter(const std::string& path, int keep_frames, MPI_Comm comm)
+    : path_(path), comm_(parallel_comm(comm, rank_)) {
   QuietErrors quiet;
-  Handle fapl(make_fapl(path_), H5Pclose);
+  Handle fapl(make_fapl(path_, comm_), H5Pclose);
   file_ = check(H5Fopen(path_.c_str(), H5F_ACC_RDWR, fapl.get()), path_, "cannot open for appending");
   try {
     for (int i = 0; i < keep_frames; ++i) {
@@ -234,12 +261,22 @@ std::int64_t Hdf5FrameWriter::frame_group(const std::string& dataset) const {
 
 void Hdf5FrameWriter::write_array(const std::string& name, const double* data,
                                   std::size_t rows, std::size_t cols) {
-  write_dataset(frame_group(name), frame_name_, name, false, data, rows, cols);
+  write_dataset(frame_group(name), frame_name_, name, false, data, rows, 0, rows, cols, true);
 }
 
 void Hdf5FrameWriter::write_array(const std::string& name, const long long* data,
                                   std::size_t rows, std::size_t cols) {
-  write_dataset(frame_group(name), frame_name_, name, true, data, rows, cols);
+  write_dataset(frame_group(name), frame_name_, name, true, data, rows, 0, rows, cols, true);
+}
+
+void Hdf5FrameWriter::write_rows(const std::string& name, const double* data, std::size_t rows,
+                                 std::size_t first_row, std::size_t total_rows, std::size_t cols) {
+  write_dataset(frame_group(name), frame_name_, name, false, data, rows, first_row, total_rows, cols, false);
+}
+
+void Hdf5FrameWriter::write_rows(const std::string& name, const long long* data, std::size_t rows,
+                                 std::size_t first_row, std::size_t total_rows, std::size_t cols) {
+  write_dataset(frame_group(name), frame_name_, name, true, data, rows, first_row, total_rows, cols, false);
 }
 
 std::int64_t Hdf5FrameWriter::mesh_group() {
@@ -259,41 +296,91 @@ void Hdf5FrameWriter::flush(const std::string& after) {
 
 void Hdf5FrameWriter::write_static(const std::string& name, const double* data,
                                    std::size_t rows, std::size_t cols) {
-  write_dataset(mesh_group(), "/mesh", name, false, data, rows, cols);
+  write_dataset(mesh_group(), "/mesh", name, false, data, rows, 0, rows, cols, true);
   flush("/mesh/" + name);
 }
 
 void Hdf5FrameWriter::write_static(const std::string& name, const long long* data,
                                    std::size_t rows, std::size_t cols) {
-  write_dataset(mesh_group(), "/mesh", name, true, data, rows, cols);
+  write_dataset(mesh_group(), "/mesh", name, true, data, rows, 0, rows, cols, true);
   flush("/mesh/" + name);
+}
+
+void Hdf5FrameWriter::write_static_rows(const std::string& name, const long long* data, std::size_t rows,
+                                        std::size_t first_row, std::size_t total_rows, std::size_t cols) {
+  write_dataset(mesh_group(), "/mesh", name, true, data, rows, first_row, total_rows, cols, false);
+  flush("/mesh/" + name);
+}
+
+void Hdf5FrameWriter::agree(const std::string& mine, const std::string& what) const {
+  if (!parallel()) {
+    if (!mine.empty()) throw std::runtime_error(mine);
+    return;
+  }
+  int ok = mine.empty() ? 1 : 0, all = 0;
+  MPI_Allreduce(&ok, &all, 1, MPI_INT, MPI_MIN, comm_);
+  if (all) return;
+  throw std::runtime_error(mine.empty() ? "HDF5 file '" + path_ + "': " + what + " failed on another MPI rank" : mine);
 }
 
 void Hdf5FrameWriter::write_dataset(std::int64_t loc, const std::string& loc_name,
                                     const std::string& name, bool integer, const void* data,
-                                    std::size_t rows, std::size_t cols) {
+                                    std::size_t rows, std::size_t first_row, std::size_t total_rows,
+                                    std::size_t cols, bool replicated) {
   const std::string full = loc_name + "/" + name;
-  if (name.empty() || name.find('/') != std::string::npos || name == "." || name == "..")
-    throw std::invalid_argument("HDF5 file '" + path_ + "': dataset name '" + name +
-                                "' in '" + loc_name + "': expected a non-empty name without '/'");
-  if (cols == 0 || (data == nullptr && rows > 0))
-    throw std::invalid_argument("HDF5 file '" + path_ + "': dataset '" + full + "' with " +
-                                std::to_string(rows) + "x" + std::to_string(cols) +
-                                (cols == 0 ? " values: expected cols >= 1" : " values and no data"));
-  QuietErrors quiet;
   const std::string what = "cannot write dataset '" + full + "'";
-  if (check(H5Lexists(loc, name.c_str(), H5P_DEFAULT), path_, what) > 0)
-    throw std::runtime_error("HDF5 file '" + path_ + "': dataset '" + full + "' already exists");
-  const hsize_t dims[2] = {static_cast<hsize_t>(rows), static_cast<hsize_t>(cols)};
-  Handle space(check(H5Screate_simple(cols == 1 ? 1 : 2, dims, nullptr), path_, what), H5Sclose);
-  const hid_t file_type = integer ? H5T_STD_I64LE : H5T_IEEE_F64LE;
-  const hid_t mem_type = integer ? H5T_NATIVE_LLONG : H5T_NATIVE_DOUBLE;
-  Handle dset(check(H5Dcreate2(loc, name.c_str(), file_type, space.get(), H5P_DEFAULT,
-                               H5P_DEFAULT, H5P_DEFAULT),
-                    path_, what),
-              H5Dclose);
-  if (rows > 0)
-    check(H5Dwrite(dset.get(), mem_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, data), path_, what);
+  // Arguments checked, and (parallel) agreed on, before the collective create.
+  std::string bad_args;
+  try {
+    if (name.empty() || name.find('/') != std::string::npos || name == "." || name == "..")
+      throw std::invalid_argument("HDF5 file '" + path_ + "': dataset name '" + name +
+                                  "' in '" + loc_name + "': expected a non-empty name without '/'");
+    if (cols == 0 || (data == nullptr && rows > 0))
+      throw std::invalid_argument("HDF5 file '" + path_ + "': dataset '" + full + "' with " +
+                                  std::to_string(rows) + "x" + std::to_string(cols) +
+                                  (cols == 0 ? " values: expected cols >= 1" : " values and no data"));
+    if (first_row + rows > total_rows || (!parallel() && rows != total_rows))
+      throw std::invalid_argument("HDF5 file '" + path_ + "': dataset '" + full + "': rows " +
+                                  std::to_string(first_row) + ".." + std::to_string(first_row + rows) + " of " +
+                                  std::to_string(total_rows) +
+                                  (parallel() ? ": expected a block inside the dataset"
+                                              : ": expected every row (a serial writer writes whole datasets)"));
+  } catch (const std::invalid_argument& e) {
+    if (!parallel()) throw;
+    bad_args = e.what();
+  }
+  agree(bad_args, what);
+  std::string error;
+  try {
+    QuietErrors quiet;
+    if (check(H5Lexists(loc, name.c_str(), H5P_DEFAULT), path_, what) > 0)
+      throw std::runtime_error("HDF5 file '" + path_ + "': dataset '" + full + "' already exists");
+    const hsize_t dims[2] = {static_cast<hsize_t>(total_rows), static_cast<hsize_t>(cols)};
+    const int ndims = cols == 1 ? 1 : 2;
+    Handle space(check(H5Screate_simple(ndims, dims, nullptr), path_, what), H5Sclose);
+    const hid_t file_type = integer ? H5T_STD_I64LE : H5T_IEEE_F64LE;
+    const hid_t mem_type = integer ? H5T_NATIVE_LLONG : H5T_NATIVE_DOUBLE;
+    Handle dset(check(H5Dcreate2(loc, name.c_str(), file_type, space.get(), H5P_DEFAULT,
+                                 H5P_DEFAULT, H5P_DEFAULT),
+                      path_, what),
+                H5Dclose);
+    // Replicated data: rank 0 transfers them (independent I/O); the others
+    // only took part in the collective create.
+    const bool transfer = rows > 0 && !(replicated && rank_ != 0);
+    if (transfer && rows == total_rows) {
+      check(H5Dwrite(dset.get(), mem_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, data), path_, what);
+    } else if (transfer) {
+      const hsize_t start[2] = {static_cast<hsize_t>(first_row), 0};
+      const hsize_t count[2] = {static_cast<hsize_t>(rows), static_cast<hsize_t>(cols)};
+      check(H5Sselect_hyperslab(space.get(), H5S_SELECT_SET, start, nullptr, count, nullptr), path_, what);
+      Handle mem(check(H5Screate_simple(ndims, count, nullptr), path_, what), H5Sclose);
+      check(H5Dwrite(dset.get(), mem_type, mem.get(), space.get(), H5P_DEFAULT, data), path_, what);
+    }
+  } catch (const std::exception& e) {
+    error = e.what();
+    if (error.empty()) error = "HDF5 file '" + path_ + "': " + what;
+  }
+  agree(error, what);
 }
 
 std::vector<double> read_dataset(const std::string& file, const std::string& path,

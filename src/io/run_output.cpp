@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "io/atomic_file.hpp"
+#include "mpm/particle_distribution.hpp"
 
 namespace bfemp {
 
@@ -53,37 +54,60 @@ std::string prepare_dir(const std::string& dir) {
 }
 }  // namespace
 
+namespace {
+int rank_of(MPI_Comm comm) {
+  int r = 0;
+  if (comm != MPI_COMM_NULL) MPI_Comm_rank(comm, &r);
+  return r;
+}
+}  // namespace
+
 template <int dim>
 RunOutput<dim>::RunOutput(const std::string& dir, const Scene& scene, const Simulation<dim>& sim,
-                          const OutputResume* resume)
-    : dir_(prepare_dir(dir)), xdmf_(dir + "/bfemp.xdmf", "bfemp.h5") {
+                          const OutputResume* resume, MPI_Comm comm)
+    : dir_(prepare_dir(dir)), root_(rank_of(comm) == 0), xdmf_(dir + "/bfemp.xdmf", "bfemp.h5") {
   const std::set<std::string> ints = {"step", "newton_iters", "linear_iters", "active_grid_nodes", "contact_pairs",
                                       "friction_iters", "penetrations"};
+  const auto columns = diagnostics_columns(sim.body_names());
   if (resume) {
-    h5_ = std::make_unique<Hdf5FrameWriter>(dir + "/bfemp.h5", resume->frames);
-    csv_ = std::make_unique<DiagnosticsCsv>(dir + "/diagnostics.csv", diagnostics_columns(sim.body_names()), ints, resume->step);
-    for (int i = 0; i < resume->frames; ++i) xdmf_.add_frame(xdmf_frame(sim, i, h5_->frame_time(i)), false);
-    xdmf_.write();
+    h5_ = std::make_unique<Hdf5FrameWriter>(dir + "/bfemp.h5", resume->frames, comm);
+    if (root_) {
+      csv_ = std::make_unique<DiagnosticsCsv>(dir + "/diagnostics.csv", columns, ints, resume->step);
+      for (int i = 0; i < resume->frames; ++i) xdmf_.add_frame(xdmf_frame(sim, i, h5_->frame_time(i)), false);
+      xdmf_.write();
+    }
     frame_ = resume->frames;
   } else {
-    h5_ = std::make_unique<Hdf5FrameWriter>(dir + "/bfemp.h5");
-    csv_ = std::make_unique<DiagnosticsCsv>(dir + "/diagnostics.csv", diagnostics_columns(sim.body_names()), ints);
+    h5_ = std::make_unique<Hdf5FrameWriter>(dir + "/bfemp.h5", comm);
+    if (root_) csv_ = std::make_unique<DiagnosticsCsv>(dir + "/diagnostics.csv", columns, ints);
   }
-  std::ostringstream yaml;
-  yaml << std::showpoint;
-  Teuchos::writeParameterListToYamlOStream(scene.params, yaml);
-  write_file_atomically(dir + "/scene.yaml", yaml.str());
+  if (root_) {
+    std::ostringstream yaml;
+    yaml << std::showpoint;
+    Teuchos::writeParameterListToYamlOStream(scene.params, yaml);
+    write_file_atomically(dir + "/scene.yaml", yaml.str());
+  }
+  if (resume) return;
   auto cells = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), sim.mesh().elements.nodes);
   std::vector<long long> conn(cells.size());
   for (std::size_t e = 0; e < cells.extent(0); ++e)
     for (int a = 0; a <= dim; ++a) conn[e * (dim + 1) + a] = cells(e, a);
-  if (!conn.empty() && !resume) h5_->write_static("cells", conn.data(), cells.extent(0), dim + 1);
+  if (!conn.empty()) h5_->write_static("cells", conn.data(), cells.extent(0), dim + 1);
   // Explicit polyvertex connectivity 0 .. np-1: without it ParaView's Xdmf3
   // readers give the particle grid points but no cells (nothing is drawn).
-  if (const auto* mpm = sim.mpm(); mpm && !resume) {
-    std::vector<long long> ids(static_cast<std::size_t>(mpm->total_particles()));
-    for (std::size_t q = 0; q < ids.size(); ++q) ids[q] = static_cast<long long>(q);
-    h5_->write_static("particle_vertices", ids.data(), ids.size(), 1);
+  // Each rank writes its id block of it.
+  if (const auto* mpm = sim.mpm()) {
+    const long long n = mpm->total_particles();
+    int rank = 0, size = 1;
+    if (h5_->parallel()) {
+      MPI_Comm_rank(comm, &rank);
+      MPI_Comm_size(comm, &size);
+    }
+    const long long lo = id_block_begin(n, rank, size), hi = id_block_begin(n, rank + 1, size);
+    std::vector<long long> ids(static_cast<std::size_t>(hi - lo));
+    for (std::size_t q = 0; q < ids.size(); ++q) ids[q] = lo + static_cast<long long>(q);
+    h5_->write_static_rows("particle_vertices", ids.data(), ids.size(), static_cast<std::size_t>(lo),
+                           static_cast<std::size_t>(n), 1);
   }
 }
 
@@ -116,8 +140,7 @@ XdmfFrame RunOutput<dim>::xdmf_frame(const Simulation<dim>& sim, int index, doub
 }
 
 template <int dim>
-void RunOutput<dim>::write_frame(const Simulation<dim>& sim, const Particles<dim>* gathered,
-                                 const std::vector<double>* gathered_forces) {
+void RunOutput<dim>::write_frame(const Simulation<dim>& sim, const ParticleRows<dim>* rows) {
   const auto& mesh = sim.mesh();
   const std::size_t nn = mesh.num_nodes(), ne = mesh.num_cells();
   auto x = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), sim.positions());
@@ -128,15 +151,16 @@ void RunOutput<dim>::write_frame(const Simulation<dim>& sim, const Particles<dim
   auto Jh = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), J);
   auto vmh = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), vm);
   h5_->begin_frame(frame_, sim.time(), sim.step_index());
-  if (nn > 0) {
+  if (nn > 0) {  // the FEM state (replicated on every rank)
     h5_->write_array("positions", x.data(), nn, dim);
     h5_->write_array("velocities", v.data(), nn, dim);
     h5_->write_array("von_mises", vmh.data(), ne, 1);
     h5_->write_array("J", Jh.data(), ne, 1);
   }
   if (const auto* mpm = sim.mpm()) {
-    const auto& p = gathered ? *gathered : mpm->particles();
-    const std::size_t np = p.size();
+    const auto& p = rows ? rows->particles : mpm->particles();
+    const std::size_t np = p.size(), first = rows ? static_cast<std::size_t>(rows->first) : 0;
+    const std::size_t total = rows ? static_cast<std::size_t>(mpm->total_particles()) : np;
     Kokkos::View<double*, MemSpace> pJ("frame_particle_J", np), pvm("frame_particle_vm", np);
     mpm_particle_J_von_mises<dim>(p, sim.mesh().elements.materials, pJ, pvm);
     auto px = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), p.x);
@@ -145,24 +169,35 @@ void RunOutput<dim>::write_frame(const Simulation<dim>& sim, const Particles<dim
     auto pJh = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), pJ);
     auto pvmh = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), pvm);
     std::vector<long long> body(pb.data(), pb.data() + np);
-    h5_->write_array("particle_positions", px.data(), np, dim);
-    h5_->write_array("particle_velocities", pv.data(), np, dim);
-    h5_->write_array("particle_von_mises", pvmh.data(), np, 1);
-    h5_->write_array("particle_J", pJh.data(), np, 1);
-    h5_->write_array("particle_body", body.data(), np, 1);
-    const auto* contact = sim.contact();
-    if (contact && gathered_forces && gathered_forces->size() == np * dim) {
-      h5_->write_array("particle_contact_force", gathered_forces->data(), np, dim);
-    } else if (contact && !gathered && contact->particle_forces().extent(0) == np * dim) {
-      auto f = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), contact->particle_forces());
-      h5_->write_array("particle_contact_force", f.data(), np, dim);
-    } else if (contact) {
-      const std::vector<double> zero(np * dim, 0.0);  // frame 0: no step solved yet
-      h5_->write_array("particle_contact_force", zero.data(), np, dim);
+    // This rank's rows, or (no rows: every rank has all particles) rank 0 writes.
+    auto put = [&](const char* name, const auto* data, std::size_t cols) {
+      if (rows)
+        h5_->write_rows(name, data, np, first, total, cols);
+      else
+        h5_->write_array(name, data, np, cols);
+    };
+    put("particle_positions", px.data(), dim);
+    put("particle_velocities", pv.data(), dim);
+    put("particle_von_mises", pvmh.data(), 1);
+    put("particle_J", pJh.data(), 1);
+    put("particle_body", body.data(), 1);
+    if (const auto* contact = sim.contact()) {
+      Kokkos::View<const double*, MemSpace> f;
+      if (rows)
+        f = rows->contact_forces;
+      else if (contact->particle_forces().extent(0) == np * dim)
+        f = contact->particle_forces();
+      if (f.extent(0) == np * dim) {
+        auto fh = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), f);
+        put("particle_contact_force", fh.data(), dim);
+      } else {
+        const std::vector<double> zero(np * dim, 0.0);  // frame 0: no step solved yet
+        put("particle_contact_force", zero.data(), dim);
+      }
     }
   }
   h5_->end_frame();
-  xdmf_.add_frame(xdmf_frame(sim, frame_, sim.time()));
+  if (root_) xdmf_.add_frame(xdmf_frame(sim, frame_, sim.time()));
   ++frame_;
 }
 

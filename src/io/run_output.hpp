@@ -31,19 +31,34 @@ struct OutputResume {
   long step = 0;
 };
 
+// This rank's rows of the particle datasets of a frame (MPI runs of MPM
+// bodies): the particles with ids first .. first + particles.size() - 1, in id
+// order (particles_in_id_block), and their contact forces (dim per particle;
+// empty before the first contact report: zeros are written).
+template <int dim>
+struct ParticleRows {
+  Particles<dim> particles;
+  long long first = 0;
+  Kokkos::View<const double*, MemSpace> contact_forces;
+};
+
+// MPI: with a communicator of R > 1 ranks every rank constructs the output and
+// calls every member (collective); bfemp.h5 is written by all ranks through
+// MPI-IO (Hdf5FrameWriter), the text files (bfemp.xdmf, diagnostics.csv,
+// scene.yaml) by rank 0 alone (the others ignore write_diagnostics).
 template <int dim>
 class RunOutput {
  public:
   // A new output (files created or truncated), or with `resume` the
   // continuation of the directory's existing files.
   RunOutput(const std::string& dir, const Scene& scene, const Simulation<dim>& sim,
-            const OutputResume* resume = nullptr);
-  // MPI runs of MPM bodies pass every rank's particles gathered in id order
-  // (MpmBodies::gathered_particles); otherwise the simulation's are written.
-  // (with their contact forces, id order, when the scene has contact).
-  void write_frame(const Simulation<dim>& sim, const Particles<dim>* gathered = nullptr,
-                   const std::vector<double>* gathered_forces = nullptr);
-  void write_diagnostics(const StepReport& r) { csv_->write_row(diagnostics_row(r)); }
+            const OutputResume* resume = nullptr, MPI_Comm comm = MPI_COMM_NULL);
+  // MPI runs of MPM bodies pass this rank's rows of the particles (every
+  // rank); otherwise the simulation's particles are written whole.
+  void write_frame(const Simulation<dim>& sim, const ParticleRows<dim>* rows = nullptr);
+  void write_diagnostics(const StepReport& r) {
+    if (csv_) csv_->write_row(diagnostics_row(r));
+  }
   void close() { h5_->close(); }
   int frames_written() const { return frame_; }
   const std::string& dir() const { return dir_; }
@@ -52,6 +67,7 @@ class RunOutput {
   XdmfFrame xdmf_frame(const Simulation<dim>& sim, int index, double time) const;
 
   std::string dir_;
+  bool root_ = true;
   std::unique_ptr<Hdf5FrameWriter> h5_;
   XdmfSeriesWriter xdmf_;
   std::unique_ptr<DiagnosticsCsv> csv_;

@@ -1,5 +1,7 @@
 #include "mpm/mpm_bodies.hpp"
 
+#include <Kokkos_Timer.hpp>
+
 #include "solver/tpetra_types.hpp"
 
 #include <Teuchos_CommHelpers.hpp>
@@ -124,11 +126,13 @@ void MpmBodies<dim>::replace_particles(const Particles<dim>& all) {
 template <int dim>
 long long MpmBodies<dim>::migrate() {
   if (!distributed_) return 0;
+  Kokkos::Timer timer;
   long long largest = 0;
   long long moved = migrate_particles(setup_.particles, ids_, slabs_, *comm_, largest);
   moved += rebalance(largest);
   if (moved > 0) resize_stencils();
   migrated_ += moved;
+  migration_s_ += timer.seconds();
   return moved;
 }
 

@@ -110,6 +110,9 @@ class MpmBodies {
   // moved over all ranks.
   long long migrate();
   long long migrated_particles() const { return migrated_; }  // since construction, all ranks
+  // Seconds in migrate() since construction on this rank (the exchange, the
+  // wait for the other ranks in it, and any rebalance).
+  double migration_seconds() const { return migration_s_; }
   int rebalances() const { return rebalances_; }
   // max / mean of the ranks' particle counts after the last migrate() (1 on one rank).
   double imbalance() const { return imbalance_; }
@@ -173,6 +176,7 @@ class MpmBodies {
   ParticleSlabs<dim> slabs_;
   Kokkos::View<long long*, MemSpace> ids_;
   long long n_total_ = 0, migrated_ = 0;
+  double migration_s_ = 0;
   int rebalances_ = 0;
   double imbalance_ = 1.0, retry_above_ = 0.0;  // retry_above_: a failed rebalance waits for more imbalance
   long long rebalance(long long largest_count);  // largest_count: from the migration's reduction

@@ -47,7 +47,7 @@ void unpack(Kokkos::View<const double**, Kokkos::LayoutRight, MemSpace> buf, std
       "mpm_unpack_particles", Kokkos::RangePolicy<ExecSpace>(0, n), KOKKOS_LAMBDA(const std::size_t k) {
         int f = 0;
         const long long id = static_cast<long long>(buf(k, f++));
-        const std::size_t q = by_id ? static_cast<std::size_t>(id) : offset + k;
+        const std::size_t q = by_id ? static_cast<std::size_t>(id) - offset : offset + k;
         if (ids.extent(0) > 0) ids(q) = id;
         for (int c = 0; c < dim; ++c) p.x(q, c) = buf(k, f++);
         for (int c = 0; c < dim; ++c) p.v(q, c) = buf(k, f++);
@@ -62,22 +62,16 @@ void unpack(Kokkos::View<const double**, Kokkos::LayoutRight, MemSpace> buf, std
       });
 }
 
-// Particles grouped by destination rank: order lists the particles of rank
-// `first` first, then ranks 0, 1, ... (skipping `first`); count[r] per rank.
-template <int dim>
-Kokkos::View<LO*, MemSpace> group_by_owner(const Particles<dim>& p, const ParticleSlabs<dim>& s, int first,
-                                           std::vector<long long>& count) {
-  const LO np = static_cast<LO>(p.size());
-  Kokkos::View<int*, MemSpace> dest("mpm_particle_dest", np);
-  const auto px = p.x;
-  const int axis = s.axis;
-  Kokkos::parallel_for(
-      "mpm_particle_owner", Kokkos::RangePolicy<ExecSpace>(0, np),
-      KOKKOS_LAMBDA(const LO q) { dest(q) = s.owner(px(q, axis)); });
+// Particles grouped by destination rank dest(q): order lists the particles
+// of rank `first` first, then ranks 0, 1, ... (skipping `first`); count[r]
+// per rank.
+Kokkos::View<LO*, MemSpace> group_by_dest(Kokkos::View<const int*, MemSpace> dest, int nranks, int first,
+                                          std::vector<long long>& count) {
+  const LO np = static_cast<LO>(dest.extent(0));
   Kokkos::View<LO*, MemSpace> order("mpm_particle_order", np);
-  count.assign(s.nranks, 0);
+  count.assign(nranks, 0);
   LO offset = 0;
-  for (int k = -1; k < s.nranks; ++k) {
+  for (int k = -1; k < nranks; ++k) {
     const int r = k < 0 ? first : k;
     if (k >= 0 && r == first) continue;
     LO n = 0;
@@ -96,6 +90,37 @@ Kokkos::View<LO*, MemSpace> group_by_owner(const Particles<dim>& p, const Partic
   return order;
 }
 
+// The same by the slab that holds each particle.
+template <int dim>
+Kokkos::View<LO*, MemSpace> group_by_owner(const Particles<dim>& p, const ParticleSlabs<dim>& s, int first,
+                                           std::vector<long long>& count) {
+  const LO np = static_cast<LO>(p.size());
+  Kokkos::View<int*, MemSpace> dest("mpm_particle_dest", np);
+  const auto px = p.x;
+  const int axis = s.axis;
+  Kokkos::parallel_for(
+      "mpm_particle_owner", Kokkos::RangePolicy<ExecSpace>(0, np),
+      KOKKOS_LAMBDA(const LO q) { dest(q) = s.owner(px(q, axis)); });
+  return group_by_dest(dest, s.nranks, first, count);
+}
+
+// The same by the id block (id_block_begin) that holds each particle's id.
+Kokkos::View<LO*, MemSpace> group_by_id_block(Kokkos::View<const long long*, MemSpace> ids, long long n_total,
+                                              int nranks, int first, std::vector<long long>& count) {
+  const LO np = static_cast<LO>(ids.extent(0));
+  Kokkos::View<int*, MemSpace> dest("mpm_particle_dest", np);
+  Kokkos::parallel_for(
+      "mpm_id_block_owner", Kokkos::RangePolicy<ExecSpace>(0, np), KOKKOS_LAMBDA(const LO q) {
+        const long long id = ids(q);
+        const long long guess = n_total > 0 ? id * nranks / n_total : 0;
+        int r = static_cast<int>(guess < nranks - 1 ? guess : nranks - 1);
+        while (r > 0 && id < id_block_begin(n_total, r, nranks)) --r;
+        while (r + 1 < nranks && id >= id_block_begin(n_total, r + 1, nranks)) ++r;
+        dest(q) = r;
+      });
+  return group_by_dest(dest, nranks, first, count);
+}
+
 using Buffer = Kokkos::View<double**, Kokkos::LayoutRight, MemSpace>;
 
 // MPI's type of one row of `width` doubles: counts and displacements in rows
@@ -110,6 +135,38 @@ struct RowType {
   RowType(const RowType&) = delete;
   RowType& operator=(const RowType&) = delete;
 };
+
+// Rows of `width` doubles grouped by destination (group_by_dest with
+// first = this rank: count[me] rows that stay, then ranks 0, 1, ... without
+// this one) sent to their ranks (collective: one all-to-all of counts, one of
+// rows). Returns the rows received from the other ranks, on the device.
+Kokkos::View<double**, Kokkos::LayoutRight, MemSpace> exchange_rows(
+    Kokkos::View<const double**, Kokkos::LayoutRight, MemSpace> rows, const std::vector<long long>& count,
+    const Teuchos::Comm<int>& comm) {
+  const int me = comm.getRank(), n = comm.getSize();
+  const int width = static_cast<int>(rows.extent(1));
+  auto hb = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), rows);
+  // Counts and displacements in rows: this rank's own rows come first in hb.
+  std::vector<int> scount(n, 0), sdisp(n, 0), rcount(n, 0), rdisp(n, 0);
+  long long row = count[me];
+  for (int r = 0; r < n; ++r) {
+    if (r == me) continue;
+    scount[r] = static_cast<int>(count[r]);
+    sdisp[r] = static_cast<int>(row);
+    row += count[r];
+  }
+  MPI_Comm c = raw_mpi_comm(comm);
+  MPI_Alltoall(scount.data(), 1, MPI_INT, rcount.data(), 1, MPI_INT, c);
+  long long recv = 0;
+  for (int r = 0; r < n; ++r) {
+    rdisp[r] = static_cast<int>(recv);
+    recv += rcount[r];
+  }
+  Kokkos::View<double**, Kokkos::LayoutRight, Kokkos::HostSpace> hr("mpm_exchange_recv", recv, width);
+  const RowType t(width);
+  MPI_Alltoallv(hb.data(), scount.data(), sdisp.data(), t.t, hr.data(), rcount.data(), rdisp.data(), t.t, c);
+  return Kokkos::create_mirror_view_and_copy(MemSpace(), hr);
+}
 
 // Every rank's n_rows rows of `width` doubles (host, row-major) on `root`,
 // rank after rank (collective); the root checks that there are `expected`.
@@ -250,37 +307,12 @@ long long migrate_particles(Particles<dim>& p, Kokkos::View<long long*, MemSpace
   constexpr int nf = kFields<dim>;
   Buffer buf("mpm_migrate_buffer", np, nf);
   pack<dim>(p, ids, order, buf);
-  auto hb = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), buf);
-  // Send counts (in doubles) and displacements into hb: rank me's own rows
-  // come first, then ranks 0, 1, ... without me.
-  // Counts and displacements in particles (rows of nf doubles).
-  std::vector<int> scount(n, 0), sdisp(n, 0), rcount(n, 0), rdisp(n, 0);
-  long long row = count[me];
-  for (int r = 0; r < n; ++r) {
-    if (r == me) continue;
-    scount[r] = static_cast<int>(count[r]);
-    sdisp[r] = static_cast<int>(row);
-    row += count[r];
-  }
-  MPI_Comm c = raw_mpi_comm(comm);
-  MPI_Alltoall(scount.data(), 1, MPI_INT, rcount.data(), 1, MPI_INT, c);
-  long long recv = 0;
-  for (int r = 0; r < n; ++r) {
-    rdisp[r] = static_cast<int>(recv);
-    recv += rcount[r];
-  }
-  Kokkos::View<double**, Kokkos::LayoutRight, Kokkos::HostSpace> hr("mpm_migrate_recv", recv, nf);
-  const RowType particle(nf);
-  MPI_Alltoallv(hb.data(), scount.data(), sdisp.data(), particle.t, hr.data(), rcount.data(), rdisp.data(),
-                particle.t, c);
-  const std::size_t kept = static_cast<std::size_t>(count[me]), arrived = static_cast<std::size_t>(recv);
+  const auto rb = exchange_rows(buf, count, comm);
+  const std::size_t kept = static_cast<std::size_t>(count[me]), arrived = rb.extent(0);
   Particles<dim> out = allocate_particles<dim>(kept + arrived);
   Kokkos::View<long long*, MemSpace> out_ids("mpm_particle_ids", kept + arrived);
   unpack<dim>(Kokkos::subview(buf, std::make_pair(std::size_t(0), kept), Kokkos::ALL()), kept, out, out_ids, 0, false);
-  if (arrived > 0) {
-    auto rb = Kokkos::create_mirror_view_and_copy(MemSpace(), hr);
-    unpack<dim>(rb, arrived, out, out_ids, kept, false);
-  }
+  if (arrived > 0) unpack<dim>(rb, arrived, out, out_ids, kept, false);
   Kokkos::fence();
   p = out;
   ids = out_ids;
@@ -309,29 +341,64 @@ Particles<dim> gather_particles(const Particles<dim>& p, Kokkos::View<const long
   return out;
 }
 
-std::vector<double> gather_particle_values(Kokkos::View<const double*, MemSpace> values, int k,
-                                           Kokkos::View<const long long*, MemSpace> ids, long long n_total,
-                                           const Teuchos::Comm<int>& comm, int root) {
-  const int me = comm.getRank();
+template <int dim>
+Particles<dim> particles_in_id_block(const Particles<dim>& p, Kokkos::View<const long long*, MemSpace> ids,
+                                     long long n_total, const Teuchos::Comm<int>& comm) {
+  const int me = comm.getRank(), n = comm.getSize();
+  const long long lo = id_block_begin(n_total, me, n), hi = id_block_begin(n_total, me + 1, n);
+  std::vector<long long> count;
+  const auto order = group_by_id_block(ids, n_total, n, me, count);
+  Buffer buf("mpm_id_block_buffer", p.size(), kFields<dim>);
+  pack<dim>(p, ids, order, buf);
+  const auto rb = exchange_rows(buf, count, comm);
+  const std::size_t kept = static_cast<std::size_t>(count[me]), arrived = rb.extent(0);
+  if (static_cast<long long>(kept + arrived) != hi - lo)
+    throw std::logic_error("particles_in_id_block: rank " + std::to_string(me) + " received " +
+                           std::to_string(kept + arrived) + " particles for ids " + std::to_string(lo) + ".." +
+                           std::to_string(hi) + " (ids not unique or out of range)");
+  Particles<dim> out = allocate_particles<dim>(hi - lo);
+  const Kokkos::View<long long*, MemSpace> none;
+  const auto lo_z = static_cast<std::size_t>(lo);
+  unpack<dim>(Kokkos::subview(buf, std::make_pair(std::size_t(0), kept), Kokkos::ALL()), kept, out, none, lo_z, true);
+  if (arrived > 0) unpack<dim>(rb, arrived, out, none, lo_z, true);
+  Kokkos::fence();
+  return out;
+}
+
+Kokkos::View<double*, MemSpace> particle_values_in_id_block(Kokkos::View<const double*, MemSpace> values, int k,
+                                                            Kokkos::View<const long long*, MemSpace> ids,
+                                                            long long n_total, const Teuchos::Comm<int>& comm) {
+  const int me = comm.getRank(), n = comm.getSize();
+  const long long lo = id_block_begin(n_total, me, n), hi = id_block_begin(n_total, me + 1, n);
   const std::size_t np = ids.extent(0);
-  if (values.extent(0) < np * k) throw std::logic_error("gather_particle_values: fewer values than particles");
-  // Rows (id, k values) of this rank's particles.
-  Kokkos::View<double**, Kokkos::LayoutRight, MemSpace> buf("mpm_gather_values", np, k + 1);
+  if (values.extent(0) < np * k) throw std::logic_error("particle_values_in_id_block: fewer values than particles");
+  std::vector<long long> count;
+  const auto order = group_by_id_block(ids, n_total, n, me, count);
+  // Rows (id, k values) grouped by destination.
+  Buffer buf("mpm_id_block_values", np, k + 1);
   Kokkos::parallel_for(
-      "mpm_pack_values", Kokkos::RangePolicy<ExecSpace>(0, np), KOKKOS_LAMBDA(const std::size_t q) {
-        buf(q, 0) = static_cast<double>(ids(q));
-        for (int j = 0; j < k; ++j) buf(q, 1 + j) = values(q * k + j);
+      "mpm_pack_values", Kokkos::RangePolicy<ExecSpace>(0, np), KOKKOS_LAMBDA(const std::size_t r) {
+        const LO q = order(r);
+        buf(r, 0) = static_cast<double>(ids(q));
+        for (int j = 0; j < k; ++j) buf(r, 1 + j) = values(q * k + j);
       });
-  auto hb = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), buf);
-  const std::vector<double> recv = gather_rows(hb.data(), static_cast<long long>(np), k + 1, comm, root, n_total,
-                                               "gather_particle_values");
-  if (me != root) return {};
-  std::vector<double> out(static_cast<std::size_t>(n_total) * k);
-  for (long long r = 0; r < n_total; ++r) {
-    const double* row = recv.data() + r * (k + 1);
-    const auto id = static_cast<std::size_t>(row[0]);
-    for (int j = 0; j < k; ++j) out[id * k + j] = row[1 + j];
-  }
+  const auto rb = exchange_rows(buf, count, comm);
+  const std::size_t kept = static_cast<std::size_t>(count[me]), arrived = rb.extent(0);
+  if (static_cast<long long>(kept + arrived) != hi - lo)
+    throw std::logic_error("particle_values_in_id_block: rank " + std::to_string(me) + " received " +
+                           std::to_string(kept + arrived) + " particles for ids " + std::to_string(lo) + ".." +
+                           std::to_string(hi));
+  Kokkos::View<double*, MemSpace> out("mpm_id_block_values_out", static_cast<std::size_t>(hi - lo) * k);
+  auto place = [&](Kokkos::View<const double**, Kokkos::LayoutRight, MemSpace> rows, std::size_t m) {
+    Kokkos::parallel_for(
+        "mpm_place_values", Kokkos::RangePolicy<ExecSpace>(0, m), KOKKOS_LAMBDA(const std::size_t r) {
+          const auto q = static_cast<std::size_t>(static_cast<long long>(rows(r, 0)) - lo);
+          for (int j = 0; j < k; ++j) out(q * k + j) = rows(r, 1 + j);
+        });
+  };
+  place(Kokkos::subview(buf, std::make_pair(std::size_t(0), kept), Kokkos::ALL()), kept);
+  if (arrived > 0) place(rb, arrived);
+  Kokkos::fence();
   return out;
 }
 
@@ -344,7 +411,9 @@ std::vector<double> gather_particle_values(Kokkos::View<const double*, MemSpace>
   template long long migrate_particles<D>(Particles<D>&, Kokkos::View<long long*, MemSpace>&,                      \
                                           const ParticleSlabs<D>&, const Teuchos::Comm<int>&, long long&);          \
   template Particles<D> gather_particles<D>(const Particles<D>&, Kokkos::View<const long long*, MemSpace>, long long, \
-                                            const Teuchos::Comm<int>&, int);
+                                            const Teuchos::Comm<int>&, int);                                        \
+  template Particles<D> particles_in_id_block<D>(const Particles<D>&, Kokkos::View<const long long*, MemSpace>,     \
+                                                 long long, const Teuchos::Comm<int>&);
 BFEMP_INSTANTIATE(2)
 BFEMP_INSTANTIATE(3)
 #undef BFEMP_INSTANTIATE

@@ -14,9 +14,11 @@
 // cost is a halo that grows with the cross-section instead of the surface.
 //
 // Every particle has a global id (its index in the scene's particle list),
-// carried through every migration: output and checkpoints gather the
-// particles to rank 0 in id order, so a run on R ranks writes the same files
-// as one on 1 rank. One rank: nothing moves, ids are 0..n-1.
+// carried through every migration. Output frames redistribute the particles
+// into contiguous id blocks (particles_in_id_block), one per rank, which the
+// ranks write into one HDF5 file with MPI-IO; checkpoints gather them to
+// rank 0 in id order. Either way a run on R ranks writes the same files as
+// one on 1 rank. One rank: nothing moves, ids are 0..n-1.
 #include <Kokkos_Core.hpp>
 #include <Teuchos_Comm.hpp>
 #include <vector>
@@ -75,10 +77,25 @@ template <int dim>
 Particles<dim> gather_particles(const Particles<dim>& p, Kokkos::View<const long long*, MemSpace> ids,
                                 long long n_total, const Teuchos::Comm<int>& comm, int root = 0);
 
-// A per-particle field (k values per particle, particle-major) of all ranks
-// on rank `root`, in id order (n_total k values; empty elsewhere; collective).
-std::vector<double> gather_particle_values(Kokkos::View<const double*, MemSpace> values, int k,
-                                           Kokkos::View<const long long*, MemSpace> ids, long long n_total,
-                                           const Teuchos::Comm<int>& comm, int root = 0);
+// The output blocks: rank r of R holds the particles with ids in
+// [id_block_begin(n, r, R), id_block_begin(n, r + 1, R)).
+KOKKOS_INLINE_FUNCTION long long id_block_begin(long long n_total, int rank, int nranks) {
+  return n_total * rank / nranks;
+}
+
+// All ranks' particles redistributed so that this rank holds its id block,
+// in id order (row q = id id_block_begin + q; ids must be 0..n_total-1, each
+// on one rank). Collective: one all-to-all of counts, one of packed particles;
+// nothing passes through one rank.
+template <int dim>
+Particles<dim> particles_in_id_block(const Particles<dim>& p, Kokkos::View<const long long*, MemSpace> ids,
+                                     long long n_total, const Teuchos::Comm<int>& comm);
+
+// A per-particle field (k values per particle, particle-major; particle q of
+// this rank has id ids(q)) redistributed the same way: this rank's id block,
+// k values per particle, in id order (collective).
+Kokkos::View<double*, MemSpace> particle_values_in_id_block(Kokkos::View<const double*, MemSpace> values, int k,
+                                                            Kokkos::View<const long long*, MemSpace> ids,
+                                                            long long n_total, const Teuchos::Comm<int>& comm);
 
 }  // namespace bfemp

@@ -11,7 +11,9 @@
 #include <sstream>
 
 #include "explicit/explicit_run.hpp"
+#include "core/mpi_comm.hpp"
 #include "io/run_output.hpp"
+#include "mpm/particle_distribution.hpp"
 #include "io/scene_explicit.hpp"
 #include "sim/interrupt.hpp"
 #include "solver/solver_error.hpp"
@@ -228,40 +230,46 @@ RunSummary run_dim(const Scene& scene, const std::string& dir, const Teuchos::RC
   if (opt.restart && opt.append) resume = {opt.restart->frames, opt.restart->step};
   // A new output must not keep an older run's checkpoint: restarting from it
   // would mix that run's state with this run's frames.
-  // Rank 0 writes every file (the FEM state is replicated; MPM particles are
-  // gathered to it for each frame and checkpoint).
+  // MPI: every rank writes its id block of the particles into bfemp.h5
+  // (MPI-IO; the FEM state is replicated and rank 0 writes it), rank 0 the
+  // text files; checkpoints gather the particles to rank 0, which writes them.
   if (root && !(opt.restart && opt.append)) std::filesystem::remove(dir + "/checkpoint.h5");
-  std::unique_ptr<RunOutput<dim>> out_ptr;
-  if (root) out_ptr = std::make_unique<RunOutput<dim>>(dir, scene, sim, opt.restart && opt.append ? &resume : nullptr);
+  if (comm->getSize() > 1) comm->barrier();  // the old checkpoint is gone before any rank goes on
+  const MPI_Comm out_comm = comm->getSize() > 1 ? raw_mpi_comm(*comm) : MPI_COMM_NULL;
+  RunOutput<dim> out(dir, scene, sim, opt.restart && opt.append ? &resume : nullptr, out_comm);
   if (opt.restart)
     log << "restart: from step " << opt.restart->step << " (t = " << opt.restart->time << " s), "
         << (opt.append ? "appending to " : "new output in ") << dir << "\n";
   const std::string ck_path = dir + "/checkpoint.h5";
   RunSummary s;
   s.contact = sim.contact() != nullptr;
+  Kokkos::Timer output_timer;
   auto checkpoint = [&] {  // collective (MPI MPM: the particles gathered to rank 0)
-    const Checkpoint c = make_checkpoint(scene, opt, sim, root ? out_ptr->frames_written() : 0);
+    output_timer.reset();
+    const Checkpoint c = make_checkpoint(scene, opt, sim, out.frames_written());
     if (root) write_checkpoint(ck_path, c);
     s.checkpoints++;
+    s.output_s += output_timer.seconds();
   };
-  auto write_frame = [&] {  // collective, as the checkpoint
-    if (sim.mpm() && sim.mpm()->distributed()) {
-      const Particles<dim> all = sim.mpm()->gathered_particles();
-      std::vector<double> forces;
-      const auto* contact = sim.contact();
-      const auto* mpm = sim.mpm();
-      // (The branch is the same on every rank: contact_reported() is.)
-      if (contact && sim.contact_reported()) {
-        forces = gather_particle_values(contact->particle_forces(), dim, sim.contact_force_ids(), mpm->total_particles(),
-                                        *comm);
-      } else if (contact) {  // before the first report (frame 0), on every rank alike: no force yet
-        Kokkos::View<double*, MemSpace> zero("frame_zero_forces", mpm->particles().size() * dim);
-        forces = gather_particle_values(zero, dim, mpm->particle_ids(), mpm->total_particles(), *comm);
-      }
-      if (root) out_ptr->write_frame(sim, &all, contact ? &forces : nullptr);
-    } else if (root) {
-      out_ptr->write_frame(sim);
+  auto write_frame = [&] {  // collective
+    output_timer.reset();
+    const auto* mpm = sim.mpm();
+    if (!mpm || !mpm->distributed()) {
+      out.write_frame(sim);
+      s.output_s += output_timer.seconds();
+      return;
     }
+    // This rank's id block of the particles and of their contact forces.
+    ParticleRows<dim> rows;
+    const long long n = mpm->total_particles();
+    rows.particles = particles_in_id_block(mpm->particles(), mpm->particle_ids(), n, *comm);
+    rows.first = id_block_begin(n, comm->getRank(), comm->getSize());
+    // (The branch is the same on every rank: contact_reported() is. Before
+    // the first report, frame 0, there is no force yet: zeros are written.)
+    if (const auto* contact = sim.contact(); contact && sim.contact_reported())
+      rows.contact_forces = particle_values_in_id_block(contact->particle_forces(), dim, sim.contact_force_ids(), n, *comm);
+    out.write_frame(sim, &rows);
+    s.output_s += output_timer.seconds();
   };
   if (!(opt.restart && opt.append)) write_frame();  // frame 0: the initial state
   const double dt = scene.params.sublist("Time").get<double>("dt");
@@ -278,14 +286,14 @@ RunSummary run_dim(const Scene& scene, const std::string& dir, const Teuchos::RC
       // works on copies until Newton returns): checkpoint it, so that the run
       // can continue with other Newton or linear-solver settings.
       checkpoint();
-      if (root) out_ptr->close();
+      out.close();
       std::ostringstream msg;
       msg << e.what() << "\n  the state after step " << sim.step_index() << " (t = " << sim.time()
           << " s) is checkpointed; continue with other solver settings, e.g.: bfemp restart " << dir
           << " --set 'Newton/max iterations=1000' (a restart may change Newton/*, Linear Solver/*, Output/*)";
       throw SolverError(msg.str());
     }
-    if (root) out_ptr->write_diagnostics(r);
+    out.write_diagnostics(r);
     accumulate(s, r);
     // A signal during the last step: the run is complete; finish normally.
     const int sig = guard && n + 1 < n_steps ? global_signal(comm) : 0;
@@ -303,15 +311,27 @@ RunSummary run_dim(const Scene& scene, const std::string& dir, const Teuchos::RC
     }
     if (sig)
       stop_after_signal(sig, r.step, r.time, dir, log, [&] {
-        if (root) out_ptr->close();
+        out.close();
       });
   }
   checkpoint();
-  if (root) out_ptr->close();
-  s.frames = root ? out_ptr->frames_written() : 0;
+  out.close();
+  s.frames = out.frames_written();
   s.wall_s = wall.seconds();
   for (const auto& [name, sec] : sim.newton().term_assembly_seconds()) s.term_assembly_s.emplace_back(name, sec);
   s.graph_builds = sim.newton().dof_space().graph_builds();
+  s.exchange_s = sim.newton().dof_space().exchange_seconds();
+  s.exchange_mb = 1e-6 * sim.newton().dof_space().exchange_bytes();
+  if (const auto* mpm = sim.mpm()) s.migration_s = mpm->migration_seconds();
+  if (comm->getSize() > 1) {  // the slowest (busiest) rank's
+    const double mine[4] = {s.exchange_s, s.migration_s, s.output_s, s.exchange_mb};
+    double most[4];
+    Teuchos::reduceAll(*comm, Teuchos::REDUCE_MAX, 4, mine, most);
+    s.exchange_s = most[0];
+    s.migration_s = most[1];
+    s.output_s = most[2];
+    s.exchange_mb = most[3];
+  }
   if (const auto* mpm = sim.mpm(); mpm && mpm->distributed()) {
     s.mpm_ranks = comm->getSize();
     s.migrations = mpm->migrated_particles();
@@ -408,6 +428,12 @@ RunSummary run_scene(const Scene& scene, const std::string& dir, const Teuchos::
     log << "  MPM on " << s.mpm_ranks << " ranks      " << s.migrations << " particle migrations, " << s.rebalances
         << " slab rebalance(s); particle imbalance at the end " << std::setprecision(3) << s.imbalance
         << " (largest / mean per rank)\n";
+  if (comm->getSize() > 1)
+    log << "  MPI exchanges       " << s.exchange_s << " s DOF export/import (within the times above; "
+        << s.exchange_mb << " MB sent), " << s.migration_s
+        << " s particle migration (slowest rank, waiting included)\n";
+  log << "  output time         " << s.output_s << " s (" << s.frames << " frames, " << s.checkpoints
+      << " checkpoint(s))\n";
   log << "  wall time           " << s.wall_s << " s\n"
       << "  frames written      " << s.frames << " (" << dir << "/bfemp.xdmf)\n"
       << "  checkpoint          " << dir << "/checkpoint.h5 (continue with: bfemp restart " << dir << ")\n";

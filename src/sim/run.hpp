@@ -24,6 +24,12 @@ struct RunSummary {
   double contact_broad_phase_s = 0, contact_eval_s = 0, contact_ccd_s = 0;  // parts of the above
   int frames = 0;
   int checkpoints = 0;
+  double output_s = 0;  // frames and checkpoints (the slowest rank)
+  // MPI: seconds in the DOF exchanges between ranks (the overlap sum after
+  // assembly, the import of owned values; DofSpace::exchange_seconds) and in
+  // particle migration, waiting included (the slowest rank).
+  double exchange_s = 0, migration_s = 0;
+  double exchange_mb = 0;  // MB the busiest rank sent in the DOF exchanges
   long graph_builds = 0, symbolic_factorizations = 0, numeric_factorizations = 0;
   long projected_retries = 0;  // steps redone with the projected Hessian
   long exact_hessian_iterations = 0, projection_fallbacks = 0;  // Newton/hessian: exact-if-definite

@@ -198,6 +198,7 @@ void DofSpace<dim>::end_assembly(MaskView prescribed, ConstDofView dx_prescribed
   }
   // Sum the overlap matrix and rhs into the owned ones.
   A_overlap_->fillComplete(map_, map_, fill_params_);
+  Kokkos::Timer timer;
   {
     auto rv = Kokkos::subview(rhs_overlap_->getLocalViewDevice(Tpetra::Access::OverwriteAll), Kokkos::ALL(), 0);
     Kokkos::deep_copy(rv, rhs);
@@ -206,6 +207,8 @@ void DofSpace<dim>::end_assembly(MaskView prescribed, ConstDofView dx_prescribed
   b.doExport(*rhs_overlap_, *export_, Tpetra::ADD);
   A_->resumeFill();
   matrix_sum_->sum(*A_overlap_, *A_);
+  exchange_s_ += timer.seconds();
+  exchange_bytes_ += 8.0 * (static_cast<double>(matrix_sum_->sent_values()) + export_->getNumExportIDs());
   // Constraint rows on the owned side (owned row r is local DOF owned_dofs(r)).
   auto lcl = A_->getLocalMatrixDevice();
   auto bv = Kokkos::subview(b.getLocalViewDevice(Tpetra::Access::ReadWrite), Kokkos::ALL(), 0);
@@ -230,7 +233,10 @@ void DofSpace<dim>::to_local(const Vector& owned, DofView local) {
     Kokkos::deep_copy(local, v);
     return;
   }
+  Kokkos::Timer timer;
   x_overlap_->doImport(owned, *import_, Tpetra::INSERT);
+  exchange_s_ += timer.seconds();
+  exchange_bytes_ += 8.0 * import_->getNumExportIDs();
   auto v = Kokkos::subview(x_overlap_->getLocalViewDevice(Tpetra::Access::ReadOnly), Kokkos::ALL(), 0);
   Kokkos::deep_copy(local, v);
 }

@@ -109,6 +109,14 @@ class DofSpace {
   void count_missing_block_rebuild() { ++missing_rebuilds_; }
   long graph_reuses() const { return graph_reuses_; }
   double last_graph_build_s() const { return graph_build_s_; }
+  // Seconds since construction on this rank in the exchanges between ranks:
+  // end_assembly's sum of the overlap matrix and right-hand side into the
+  // owned ones, and to_local's import of owned values into the overlap
+  // (waiting for the other ranks included). 0 on one rank.
+  double exchange_seconds() const { return exchange_s_; }
+  // Bytes this rank has sent in those exchanges since construction (matrix
+  // values and vector entries, 8 bytes each).
+  double exchange_bytes() const { return exchange_bytes_; }
 
  private:
   Teuchos::RCP<const Comm> comm_;
@@ -134,6 +142,7 @@ class DofSpace {
   long graph_builds_ = 0, graph_reuses_ = 0, missing_rebuilds_ = 0;
   Kokkos::View<int, MemSpace> dropped_;
   double graph_build_s_ = 0;
+  double exchange_s_ = 0, exchange_bytes_ = 0;
 };
 
 }  // namespace bfemp

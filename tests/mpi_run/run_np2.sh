@@ -4,10 +4,10 @@
 # direct solver, FEM-FEM contact and an explicit scene are refused before the
 # first step (exit 2, a message naming the key); a 2-rank run restarted on 2 ranks equals the
 # uninterrupted one bit for bit. The MPM column (MPM alone: particles in slabs) gives the same
-# frames on 1 and 2 ranks (particles gathered in scene order), and its 2-rank restart equals
+# frames on 1 and 2 ranks (particles written in scene order: each rank its block, MPI-IO), and its 2-rank restart equals
 # the uninterrupted run to solver tolerance (the restart re-cuts the slabs). The colliding
 # rings (MPM + FEM, barrier contact) write the same frames on 1 and 2 ranks, the particles'
-# contact forces included (gathered in scene order). The 3D twist (A7, coarsened, shortened)
+# contact forces included (in scene order). The 3D twist (A7, coarsened, shortened)
 # with friction on 2 ranks (CG + BLOCK_CHOLMOD) equals 1 rank (Cholmod): the cube is cut at x = 0 under the
 # shell, so contact pairs and their lagged friction live on both ranks. Usage: run_np2.sh BFEMP SOURCE_DIR WORK_DIR
 set -euo pipefail
