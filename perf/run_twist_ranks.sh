@@ -10,6 +10,11 @@
 # import, particle migration: comm_share) and in output, as JSON that
 # perf/compare.py reads (solver = the configuration, threads = ranks x threads):
 #   perf/run_twist_ranks.sh [--build-dir DIR] [--out FILE] [--steps N] [--precs "RELAXATION BLOCK_CHOLMOD"]
+#                           [--size NAME --set KEY=VALUE ...]
+# --set changes the scene for every run (e.g. a refined twist for weak
+# scaling: --size twist_weak2 --set 'MPM/grid spacing=0.1'
+# --set 'FEM Bodies/shell/Mesh/element size=0.08'); --size names it in the JSON
+# (default twist_ci).
 #   python3 perf/compare.py build/perf/twist_ranks.json --baseline perf/baselines/twist_ranks.json \
 #       --fields step_s,assembly_s,solve_s
 # Goals (MPI issue, paper size): 2 ranks >= 1.6x over 1 x 1; comm_share <= 0.1.
@@ -19,13 +24,17 @@ build_dir="$repo/build"
 out=""
 steps=15
 precs="RELAXATION BLOCK_CHOLMOD"
+size=twist_ci
+extra=()
 while [[ $# -gt 0 ]]; do
   case "$1" in
     --build-dir) build_dir="$(cd "$2" && pwd)"; shift 2 ;;
     --out) out="$2"; shift 2 ;;
     --steps) steps="$2"; shift 2 ;;
     --precs) precs="$2"; shift 2 ;;
-    -h|--help) sed -n '2,13p' "${BASH_SOURCE[0]}"; exit 0 ;;
+    --size) size="$2"; shift 2 ;;
+    --set) extra+=(--set "$2"); shift 2 ;;
+    -h|--help) sed -n '2,20p' "${BASH_SOURCE[0]}"; exit 0 ;;
     *) echo "run_twist_ranks.sh: unknown argument '$1' (see --help)" >&2; exit 2 ;;
   esac
 done
@@ -35,12 +44,12 @@ bin="$build_dir/drivers/bfemp"
 tmp="$(mktemp -d)"
 trap 'rm -rf "$tmp"' EXIT
 end_time=$(python3 -c "print(($steps + 0.5) * 1e-2)")
-common=(--set "Time/end time=$end_time" --set "Output/frame every=1000000" --set "Output/progress every=5")
+common=(--set "Time/end time=$end_time" --set "Output/frame every=1000000" --set "Output/progress every=5" "${extra[@]}")
 mpi=(mpirun --oversubscribe --allow-run-as-root --bind-to none -x OMP_PROC_BIND=false -x OPENBLAS_NUM_THREADS=1)
 runs=()
 run() {  # name ranks threads [bfemp args...]
   local name=$1 np=$2 nt=$3; shift 3
-  echo "== twist ci, $name: $np rank(s) x $nt thread(s), $steps steps"
+  echo "== $size, $name: $np rank(s) x $nt thread(s), $steps steps"
   "${mpi[@]}" -x OMP_NUM_THREADS="$nt" -np "$np" "$bin" run "$repo/inputs/a7_twist.yaml" --output "$tmp/$name" \
     "${common[@]}" "$@" > "$tmp/$name.log" 2>&1 \
     || { cat "$tmp/$name.log" >&2; echo "run_twist_ranks.sh: the run $name failed" >&2; exit 1; }
@@ -53,9 +62,9 @@ for p in $precs; do
   run "cg_$p" 2 1 --set 'Linear Solver/type=CG' --set "Linear Solver/CG/preconditioner=$p"
 done
 mkdir -p "$(dirname "$out")"
-python3 - "$out" "$repo" "${runs[@]}" <<'PY'
+python3 - "$out" "$repo" "$size" "${runs[@]}" <<'PY'
 import csv, re, sys
-out, repo, runs = sys.argv[1], sys.argv[2], sys.argv[3:]
+out, repo, size, runs = sys.argv[1], sys.argv[2], sys.argv[3], sys.argv[4:]
 sys.path.insert(0, repo + "/perf")
 from scene_stats import contact_step_means, write_results
 results = []
@@ -69,7 +78,11 @@ for spec in runs:
     outp = re.search(r"output time\s+([0-9.eE+-]+) s", text)
     steps_total = sum(float(r["step_s"]) for r in csv.DictReader(open(diag)))
     exchange, exchange_mb, migration = (float(ex.group(i)) for i in (1, 2, 3)) if ex else (0.0, 0.0, 0.0)
-    results.append({"dim": 3, "size": "twist_ci", "solver": name, "threads": int(np_) * int(nt),
+    particles = re.search(r"MPM: (\d+) particles", text)
+    dofs = re.search(r"FEM: \d+ nodes, \d+ elements, (\d+) DOFs", text)
+    results.append({"dim": 3, "size": size,
+                    "particles": int(particles.group(1)) if particles else 0,
+                    "fem_dofs": int(dofs.group(1)) if dofs else 0, "solver": name, "threads": int(np_) * int(nt),
                     "ranks": int(np_), "threads_per_rank": int(nt), "contact_steps": n, **m,
                     "run_step_s": steps_total, "exchange_s": exchange, "exchange_mb": exchange_mb, "migration_s": migration,
                     "comm_share": (exchange + migration) / steps_total if steps_total > 0 else float("nan"),
