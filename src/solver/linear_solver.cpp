@@ -385,14 +385,13 @@ LinearSolveStats LinearSolver::solve(const Vector& b, Vector& x, double forcing)
   Belos::ReturnType ret;
   try {
     ret = cg.solve();
-  } catch (const Belos::CGIterateFailure& e) {
-    // p^T A p <= 0 for a direction p != 0: with an SPD preconditioner (the
-    // block Cholesky factors) this proves A is not positive definite.
-    if (!m.block.is_null())
+  } catch (const std::exception& e) {
+    // Belos' CGIterateFailure is p^T A p <= 0 for a direction p != 0: with
+    // an SPD preconditioner (the block Cholesky factors) this proves A is
+    // not positive definite.
+    if (!m.block.is_null() && dynamic_cast<const Belos::CGIterateFailure*>(&e))
       throw NotPositiveDefinite(std::string("CG met p^T A p <= 0 under BLOCK_CHOLMOD: the matrix is not positive "
                                             "definite (") + e.what() + ")");
-    throw SolverError(std::string("CG failed (matrix not positive definite?): ") + e.what());
-  } catch (const std::exception& e) {
     throw SolverError(std::string("CG failed (matrix not positive definite?): ") + e.what());
   }
   stats.iterations = cg.getNumIters();

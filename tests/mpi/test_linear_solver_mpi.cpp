@@ -220,3 +220,54 @@ TEST(LinearSolverMpi, MisspelledMueLuKeyRefusedOnAnyRankCount) {
     EXPECT_NE(msg.find("aggregation: typo"), std::string::npos) << msg;
   }
 }
+
+// CG + BLOCK_CHOLMOD proves a matrix indefinite even when every rank's block
+// is positive definite: A = d I - (grid adjacency) on the 60 x 60 grid has
+// eigenvalues d - 2 cos(k pi / 61) - 2 cos(l pi / 61), the smallest
+// d - 3.99470; a rank's block (a strip of 30 or 20 grid rows on 2 or 3 ranks)
+// has d - 3.98709 or d - 3.97529. With d = 3.991 every block is definite
+// (their factorisations succeed) and A is not: CG meets p^T A p <= 0 under
+// the SPD block preconditioner and raises NotPositiveDefinite on every rank
+// (on 1 rank the block is A and its factorisation says so). With d = 4.0, A
+// is definite and the same solve converges.
+TEST(LinearSolverMpi, BlockCholmodCgProvesIndefinitenessWhenEveryBlockIsDefinite) {
+  auto comm = Tpetra::getDefaultComm();
+  auto A = laplacian(comm);
+  LinearSolver block(cg_with("BLOCK_CHOLMOD"), comm);
+  block.set_matrix(A);
+  auto fill = [&](double d) {
+    A->resumeFill();
+    for (LO l = 0; l < static_cast<LO>(A->getRowMap()->getNodeNumElements()); ++l) {
+      const GO r = A->getRowMap()->getGlobalElement(l);
+      const GO i = r % kN, j = r / kN;
+      std::vector<GO> cols{r};
+      std::vector<double> vals{d};
+      if (i > 0) cols.push_back(r - 1), vals.push_back(-1.0);
+      if (i < kN - 1) cols.push_back(r + 1), vals.push_back(-1.0);
+      if (j > 0) cols.push_back(r - kN), vals.push_back(-1.0);
+      if (j < kN - 1) cols.push_back(r + kN), vals.push_back(-1.0);
+      A->replaceGlobalValues(r, Teuchos::ArrayView<const GO>(cols), Teuchos::ArrayView<const double>(vals));
+    }
+    A->fillComplete();
+  };
+  ASSERT_LE(comm->getSize(), 3) << "the strip bounds above hold for 1 to 3 ranks";
+  Vector b(A->getRowMap()), x(A->getRowMap());
+  b.putScalar(1.0);  // mostly the smoothest mode: the negative one
+  fill(3.991);
+  try {
+    block.solve(b, x);
+    ADD_FAILURE() << "an indefinite matrix was solved on rank " << comm->getRank();
+  } catch (const NotPositiveDefinite& e) {
+    const bool from_cg = std::string(e.what()).find("p^T A p") != std::string::npos;
+    EXPECT_EQ(from_cg, comm->getSize() > 1)
+        << "on more than one rank the blocks are definite, so CG must be the one to find out: " << e.what();
+  }
+  fill(4.0);
+  x.putScalar(0.0);
+  const auto st = block.solve(b, x);
+  EXPECT_GE(st.iterations, 1);
+  Vector r(A->getRowMap());
+  A->apply(x, r);
+  r.update(1.0, b, -1.0);
+  EXPECT_LT(r.norm2() / b.norm2(), 1e-10);
+}
