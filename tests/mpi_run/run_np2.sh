@@ -5,7 +5,8 @@
 # first step (exit 2, a message naming the key); a 2-rank run restarted on 2 ranks equals the
 # uninterrupted one bit for bit. The MPM column (MPM alone: particles in slabs) gives the same
 # frames on 1 and 2 ranks (particles written in scene order: each rank its block, MPI-IO), and its 2-rank restart equals
-# the uninterrupted run to solver tolerance (the restart re-cuts the slabs). The colliding
+# the uninterrupted run to solver tolerance (the restart re-cuts the slabs), as does a 1-rank
+# run restarted on 2 ranks (its serial HDF5 file continued through MPI-IO). The colliding
 # rings (MPM + FEM, barrier contact) write the same frames on 1 and 2 ranks, the particles'
 # contact forces included (in scene order). The 3D twist (A7, coarsened, shortened)
 # with friction on 2 ranks (CG + BLOCK_CHOLMOD) equals 1 rank (Cholmod): the cube is cut at x = 0 under the
@@ -92,24 +93,30 @@ grep -q "MPM particles in slabs" "$work/mpm2.log" || { echo "no MPM slab line in
 "${mpi[@]}" -np 2 "$exe" run "$src/inputs/mpm_column.yaml" --output "$work/mpm2_half" --set 'Linear Solver/type=CG' --set 'Time/end time=0.1' > "$work/mpm2_half.log" 2>&1
 "${mpi[@]}" -np 2 "$exe" restart "$work/mpm2_half" --set 'Time/end time=0.2' > "$work/mpm2_restart.log" 2>&1 \
   || { echo "MPM restart on 2 ranks failed"; cat "$work/mpm2_restart.log"; exit 1; }
-/usr/bin/python3 - "$work/mpm1" "$work/mpm2" "$work/mpm2_half" <<'PY'
+# A 1-rank run (serial HDF5 file) continued on 2 ranks (the file reopened with MPI-IO).
+"${mpi[@]}" -np 1 "$exe" run "$src/inputs/mpm_column.yaml" --output "$work/mpm1_half" --set 'Linear Solver/type=CG' --set 'Time/end time=0.1' > "$work/mpm1_half.log" 2>&1
+"${mpi[@]}" -np 2 "$exe" restart "$work/mpm1_half" --set 'Time/end time=0.2' > "$work/mpm1_restart.log" 2>&1 \
+  || { echo "a 1-rank MPM run restarted on 2 ranks failed"; cat "$work/mpm1_restart.log"; exit 1; }
+/usr/bin/python3 - "$work/mpm1" "$work/mpm2" "$work/mpm2_half" "$work/mpm1_half" <<'PY'
 import sys, csv, h5py, numpy as np
-a, b, c = sys.argv[1:4]
-with h5py.File(a + "/bfemp.h5", "r") as fa, h5py.File(b + "/bfemp.h5", "r") as fb, h5py.File(c + "/bfemp.h5", "r") as fc:
+a, b, c, d1 = sys.argv[1:5]
+with h5py.File(a + "/bfemp.h5", "r") as fa, h5py.File(b + "/bfemp.h5", "r") as fb, h5py.File(c + "/bfemp.h5", "r") as fc, \
+        h5py.File(d1 + "/bfemp.h5", "r") as fd:
     fr = sorted(k for k in fa if k.startswith("frame_"))
-    assert fr == sorted(k for k in fb if k.startswith("frame_")) == sorted(k for k in fc if k.startswith("frame_")), fr
+    for other in (fb, fc, fd):
+        assert fr == sorted(k for k in other if k.startswith("frame_")), (fr, sorted(other))
     assert len(fr) == 3, fr
     for f in fr:
         for d in fa[f]:
             va = fa[f][d][()]
-            for other, name in ((fb, "2 ranks"), (fc, "2 ranks restarted")):
+            for other, name in ((fb, "2 ranks"), (fc, "2 ranks restarted"), (fd, "1 rank restarted on 2")):
                 vb = other[f][d][()]
                 assert va.shape == vb.shape, (name, f, d, va.shape, vb.shape)
                 # Newton stops at |p|/dt < 1e-10 m/s (dt 0.02): 2e-12 m per step.
                 tol = 1e-9 if d in ("particle_positions", "particle_body") else 1e-6 * max(np.abs(va).max(), 1e-12)
                 err = np.abs(va - vb).max()
                 assert err <= tol, f"{name}: {f}/{d} differs by {err}"
-for other in (b, c):
+for other in (b, c, d1):
     ra = list(csv.DictReader(open(a + "/diagnostics.csv")))
     rb = list(csv.DictReader(open(other + "/diagnostics.csv")))
     assert len(ra) == len(rb) == 10, (len(ra), len(rb))
@@ -118,7 +125,7 @@ for other in (b, c):
             u, v = float(x[k]), float(y[k])
             assert abs(u - v) <= 1e-7 * max(abs(u), 1e-9), (other, x["step"], k, u, v)
         assert x["active_grid_nodes"] == y["active_grid_nodes"], (other, x["step"])
-print("MPM column: 1 rank, 2 ranks and a 2-rank restart agree (3 frames, 10 diagnostics rows)")
+print("MPM column: 1 rank, 2 ranks, a 2-rank restart and a 1-rank run restarted on 2 agree (3 frames, 10 diagnostics rows)")
 PY
 # MPM and FEM bodies in contact on 2 ranks.
 rcg=(--set 'Linear Solver/type=CG' --set 'Linear Solver/CG/tolerance=1e-13' --set 'Newton/eps_d=1e-9' --set 'Time/end time=0.03')
