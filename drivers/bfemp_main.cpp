@@ -19,8 +19,8 @@
 #include "io/scene.hpp"
 #include "solver/blas_threads.hpp"
 #include "probes/probes.hpp"
-#include "sim/interrupt.hpp"
-#include "sim/run.hpp"
+#include "app/interrupt.hpp"
+#include "app/run.hpp"
 #include "solver/solver_error.hpp"
 #include "sweep/sweep.hpp"
 

@@ -11,7 +11,7 @@
 #include <cmath>
 
 #include "core/types.hpp"
-#include "fem/det_root.hpp"
+#include "kernels/fem/det_root.hpp"
 #include "materials/material.hpp"
 
 namespace bfemp {

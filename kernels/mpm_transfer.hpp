@@ -9,10 +9,10 @@
 #include <Kokkos_ScatterView.hpp>
 
 #include "kernels/deformation_energy.hpp"
-#include "mpm/bspline.hpp"
-#include "mpm/grid.hpp"
-#include "mpm/particles.hpp"
-#include "mpm/transfer_scheme.hpp"
+#include "kernels/mpm/bspline.hpp"
+#include "kernels/mpm/grid.hpp"
+#include "kernels/mpm/particles.hpp"
+#include "kernels/mpm/transfer_scheme.hpp"
 
 namespace bfemp {
 

@@ -12,7 +12,7 @@
 //   mpio_coll parallel HDF5 (H5Pset_fapl_mpio), every rank writes its hyperslab
 //             of each dataset with a collective transfer;
 //   mpio_ind  the same with independent transfers;
-//   bfemp     what `bfemp run` does on R ranks (src/sim/run.cpp): the ranks
+//   bfemp     what `bfemp run` does on R ranks (src/app/run.cpp): the ranks
 //             hold their particles as a slab cut leaves them (here rank r the
 //             ids = r mod P, the worst case: (P-1)/P of them change rank),
 //             particles_in_id_block redistributes every particle field into

@@ -15,7 +15,7 @@
 
 #include "kernels/contact/barrier.hpp"
 #include "kernels/contact/distance.hpp"
-#include "mpm/bspline.hpp"
+#include "kernels/mpm/bspline.hpp"
 
 namespace bfemp {
 

@@ -11,7 +11,7 @@
 #include <Kokkos_ScatterView.hpp>
 
 #include "core/types.hpp"
-#include "mpm/grid.hpp"
+#include "kernels/mpm/grid.hpp"
 
 namespace bfemp::xmpm {
 

@@ -17,13 +17,13 @@
 //   h-l <= |r| < h+l : S = (h + l - |r|)^2 / (4 h l),  dS/dr = -sign(r) (h + l - |r|) / (2 h l)
 //   else 0.   Support: nodes floor(s - l/h) .. +2, s = (x_p - origin)/dx.
 // QuadraticBSpline: point-sampled quadratic B-spline (l_p unused), nodes
-// floor(s - 1/2) .. +2 (the same stencil as src/mpm/bspline.hpp).
+// floor(s - 1/2) .. +2 (the same stencil as kernels/mpm/bspline.hpp).
 // Both give sum_i S_pi = 1 and sum_i G_pi = 0 for a particle inside the grid.
 #include <Kokkos_Core.hpp>
 #include <cmath>
 
 #include "core/types.hpp"
-#include "mpm/grid.hpp"
+#include "kernels/mpm/grid.hpp"
 
 namespace bfemp::xmpm {
 

@@ -16,9 +16,9 @@
 #include "kernels/explicit/logistic_regression.hpp"
 #include "materials/hyperelastic_kg.hpp"
 #include "materials/lame.hpp"
-#include "mpm/grid.hpp"
-#include "mpm/level_set.hpp"
-#include "mpm/particles.hpp"
+#include "kernels/mpm/grid.hpp"
+#include "kernels/level_set.hpp"
+#include "kernels/mpm/particles.hpp"
 
 namespace bfemp {
 

@@ -8,7 +8,7 @@
 
 #include "core/types.hpp"
 #include "kernels/deformation_energy.hpp"
-#include "io/mesh_data.hpp"
+#include "core/mesh_data.hpp"
 #include "materials/material.hpp"
 
 namespace bfemp {

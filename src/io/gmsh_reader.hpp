@@ -2,7 +2,7 @@
 // Reader for Gmsh MSH 4.1 ASCII meshes (plain parser, does not use libgmsh).
 #include <string>
 
-#include "io/mesh_data.hpp"
+#include "core/mesh_data.hpp"
 
 namespace bfemp {
 

@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-#include "mpm/level_set.hpp"
+#include "kernels/level_set.hpp"
 #include "mpm/mpm_bodies.hpp"
 
 namespace bfemp {

@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "io/mesh_data.hpp"
+#include "core/mesh_data.hpp"
 
 namespace bfemp {
 

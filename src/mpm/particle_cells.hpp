@@ -16,9 +16,9 @@
 #include <array>
 #include <cstdint>
 
-#include "mpm/bspline.hpp"
-#include "mpm/grid.hpp"
-#include "mpm/particles.hpp"
+#include "kernels/mpm/bspline.hpp"
+#include "kernels/mpm/grid.hpp"
+#include "kernels/mpm/particles.hpp"
 
 namespace bfemp {
 

@@ -23,8 +23,8 @@
 #include <Teuchos_Comm.hpp>
 #include <vector>
 
-#include "mpm/grid.hpp"
-#include "mpm/particles.hpp"
+#include "kernels/mpm/grid.hpp"
+#include "kernels/mpm/particles.hpp"
 
 namespace bfemp {
 

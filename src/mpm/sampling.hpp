@@ -3,15 +3,15 @@
 // sub-cell centres of the lattice dx * Z^dim aligned with the origin
 // (0,...,0): with s = ppc^(1/dim) points per axis and cell, the points are
 // x_d = (m_d + 1/2) dx / s for integer m_d, so particles of every body line up
-// with the same background grid (grid_covering in mpm/grid.hpp uses the same
+// with the same background grid (grid_covering in kernels/mpm/grid.hpp uses the same
 // lattice). Each kept point represents its sub-cell: volume0 = dx^dim / ppc,
 // mass = density * volume0, v = 0, F = I, C = 0.
 #include <functional>
 #include <string>
 #include <vector>
 
-#include "io/mesh_data.hpp"
-#include "mpm/particles.hpp"
+#include "core/mesh_data.hpp"
+#include "kernels/mpm/particles.hpp"
 
 namespace bfemp {
 

@@ -15,7 +15,7 @@
 #include "fem/fem_partition.hpp"
 #include "contact/contact.hpp"
 #include "fem/prescribed_motion.hpp"
-#include "mpm/level_set.hpp"
+#include "kernels/level_set.hpp"
 #include "mpm/mpm_bodies.hpp"
 #include "solver/newton.hpp"
 #include "time/integrator.hpp"

@@ -17,7 +17,7 @@
 // p_k = P_k p_k + w_k, so x + p meets the constraint up to round-off.
 #include <Kokkos_Core.hpp>
 
-#include "mpm/level_set.hpp"
+#include "kernels/level_set.hpp"
 #include "solver/energy_term.hpp"
 
 namespace bfemp {

@@ -15,7 +15,7 @@
 #include "io/atomic_file.hpp"
 #include "io/scene.hpp"
 #include "probes/probes.hpp"
-#include "sim/run.hpp"
+#include "app/run.hpp"
 #include "solver/solver_error.hpp"
 
 namespace bfemp {

@@ -52,7 +52,7 @@ import xml.etree.ElementTree as ET
 
 FEM, PARTICLES = "fem", "particles"
 # Per layout (--grids): the grids of each frame in their order, and the arrays
-# bfemp documents for each grid (README, Output; src/explicit/explicit_output.hpp);
+# bfemp documents for each grid (README, Output; src/app/explicit_output.hpp);
 # contact_force only in contact scenes of the implicit run.
 LAYOUTS = {
     "fem,particles": {

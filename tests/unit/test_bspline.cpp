@@ -12,8 +12,8 @@
 #include <type_traits>
 #include <vector>
 
-#include "mpm/bspline.hpp"
-#include "mpm/grid.hpp"
+#include "kernels/mpm/bspline.hpp"
+#include "kernels/mpm/grid.hpp"
 
 namespace {
 

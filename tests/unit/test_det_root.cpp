@@ -9,7 +9,7 @@
 #include <limits>
 #include <random>
 
-#include "fem/det_root.hpp"
+#include "kernels/fem/det_root.hpp"
 
 namespace {
 

@@ -6,7 +6,7 @@
 
 #include <random>
 
-#include "mpm/level_set.hpp"
+#include "kernels/level_set.hpp"
 
 using namespace bfemp;
 

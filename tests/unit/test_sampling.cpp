@@ -13,7 +13,7 @@
 #include <vector>
 
 #include "io/shape_mesher.hpp"
-#include "mpm/particles.hpp"
+#include "kernels/mpm/particles.hpp"
 #include "mpm/sampling.hpp"
 
 namespace {

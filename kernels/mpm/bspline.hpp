@@ -12,7 +12,7 @@
 #include <cmath>
 
 #include "core/types.hpp"
-#include "mpm/grid.hpp"
+#include "kernels/mpm/grid.hpp"
 
 namespace bfemp {
 

@@ -1,4 +1,4 @@
-#include "sim/run.hpp"
+#include "app/run.hpp"
 
 #include <Kokkos_Timer.hpp>
 #include <Teuchos_CommHelpers.hpp>
@@ -10,12 +10,12 @@
 #include <ostream>
 #include <sstream>
 
-#include "explicit/explicit_run.hpp"
+#include "app/explicit_run.hpp"
 #include "core/mpi_comm.hpp"
 #include "io/run_output.hpp"
 #include "mpm/particle_distribution.hpp"
 #include "io/scene_explicit.hpp"
-#include "sim/interrupt.hpp"
+#include "app/interrupt.hpp"
 #include "solver/solver_error.hpp"
 
 namespace bfemp {

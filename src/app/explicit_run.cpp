@@ -1,4 +1,4 @@
-#include "explicit/explicit_run.hpp"
+#include "app/explicit_run.hpp"
 
 #include <Kokkos_Timer.hpp>
 #include <cmath>
@@ -8,10 +8,10 @@
 #include <ostream>
 #include <vector>
 
-#include "explicit/explicit_output.hpp"
+#include "app/explicit_output.hpp"
 #include "explicit/explicit_simulation.hpp"
 #include "io/scene_explicit.hpp"
-#include "sim/interrupt.hpp"
+#include "app/interrupt.hpp"
 
 namespace bfemp {
 

@@ -1,4 +1,4 @@
-#include "explicit/explicit_output.hpp"
+#include "app/explicit_output.hpp"
 
 #include <Teuchos_YamlParameterListHelpers.hpp>
 #include <cmath>

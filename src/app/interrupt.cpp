@@ -1,4 +1,4 @@
-#include "sim/interrupt.hpp"
+#include "app/interrupt.hpp"
 
 #include <ostream>
 #include <sstream>
