@@ -12,6 +12,7 @@
 #include "explicit/explicit_simulation.hpp"
 #include "io/scene_explicit.hpp"
 #include "app/interrupt.hpp"
+#include "app/run_checks.hpp"
 
 namespace bfemp {
 
@@ -61,13 +62,8 @@ ExplicitRunSummary run_dim(const Scene& scene, const std::string& dir, std::ostr
                            const ExplicitRunOptions& opt) {
   Kokkos::Timer wall;
   const RunControl rc = scene.run_control();
-  const int checkpoint_every = scene.params.sublist("Output").get<int>("checkpoint every");
-  if (checkpoint_every < 0)
-    throw std::invalid_argument("scene key 'Output/checkpoint every' = " + std::to_string(checkpoint_every) +
-                                ": expected >= 0 (0: checkpoints only at the end and on interruption)");
-  if (opt.restart && opt.restart->dim != dim)
-    throw std::invalid_argument("restart: the checkpoint is " + std::to_string(opt.restart->dim) + "D, the scene " +
-                                std::to_string(dim) + "D");
+  const int checkpoint_every = checked_checkpoint_every(scene);
+  if (opt.restart) check_restart_dimension(opt.restart->dim, dim);
   ExplicitSimulation<dim> sim(build_explicit_setup<dim>(scene));
   if (opt.restart) restore(sim, *opt.restart);
   const auto& st = sim.setup();

@@ -16,6 +16,7 @@
 #include "mpm/particle_distribution.hpp"
 #include "io/scene_explicit.hpp"
 #include "app/interrupt.hpp"
+#include "app/run_checks.hpp"
 #include "solver/solver_error.hpp"
 
 namespace bfemp {
@@ -171,13 +172,8 @@ RunSummary run_dim(const Scene& scene, const std::string& dir, const Teuchos::RC
                    std::ostream& log_root, const RunOptions& opt) {
   Kokkos::Timer wall;
   const RunControl rc = scene.run_control();
-  const int checkpoint_every = scene.params.sublist("Output").get<int>("checkpoint every");
-  if (checkpoint_every < 0)
-    throw std::invalid_argument("scene key 'Output/checkpoint every' = " + std::to_string(checkpoint_every) +
-                                ": expected >= 0 (0: checkpoints only at the end and on interruption)");
-  if (opt.restart && opt.restart->dim != dim)
-    throw std::invalid_argument("restart: the checkpoint is " + std::to_string(opt.restart->dim) +
-                                "D, the scene " + std::to_string(dim) + "D");
+  const int checkpoint_every = checked_checkpoint_every(scene);
+  if (opt.restart) check_restart_dimension(opt.restart->dim, dim);
   const bool root = comm->getRank() == 0;
   std::ostream null_log(nullptr);
   std::ostream& log = root ? log_root : null_log;  // one banner, one summary
