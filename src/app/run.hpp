@@ -30,6 +30,7 @@ struct RunSummary {
   // particle migration, waiting included (the slowest rank).
   double exchange_s = 0, migration_s = 0;
   double exchange_mb = 0;  // MB the busiest rank sent in the DOF exchanges
+  double graph_build_s = 0;  // DofSpace graph builds (the slowest rank)
   long graph_builds = 0, symbolic_factorizations = 0, numeric_factorizations = 0;
   long projected_retries = 0;  // steps redone with the projected Hessian
   long exact_hessian_iterations = 0, projection_fallbacks = 0;  // Newton/hessian: exact-if-definite

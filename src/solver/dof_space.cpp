@@ -148,6 +148,7 @@ void DofSpace<dim>::rebuild() {
   for (const auto* t : terms_) versions_.push_back(t->couplings_version());
   ++graph_builds_;
   graph_build_s_ = timer.seconds();
+  graph_build_total_s_ += graph_build_s_;
 }
 
 template <int dim>

@@ -109,6 +109,9 @@ class DofSpace {
   void count_missing_block_rebuild() { ++missing_rebuilds_; }
   long graph_reuses() const { return graph_reuses_; }
   double last_graph_build_s() const { return graph_build_s_; }
+  // All graph builds since construction on this rank (graph, matrices, the
+  // exchange plan between ranks, set_matrix).
+  double graph_build_seconds() const { return graph_build_total_s_; }
   // Seconds since construction on this rank in the exchanges between ranks:
   // end_assembly's sum of the overlap matrix and right-hand side into the
   // owned ones, and to_local's import of owned values into the overlap
@@ -141,7 +144,7 @@ class DofSpace {
   SlipConstraints<dim> slip_;
   long graph_builds_ = 0, graph_reuses_ = 0, missing_rebuilds_ = 0;
   Kokkos::View<int, MemSpace> dropped_;
-  double graph_build_s_ = 0;
+  double graph_build_s_ = 0, graph_build_total_s_ = 0;
   double exchange_s_ = 0, exchange_bytes_ = 0;
 };
 
