@@ -22,7 +22,8 @@ def main():
     out = sys.argv[2] if len(sys.argv) > 2 else os.path.join(d, "b1_errors.png")
     pairs = [("lr", "smm_flip", "LR"), ("lr_xpic5", "smm_xpic5", "LR-XPIC(5)"),
              ("cp08", "smm_flip", "CP=0.8"), ("lr_once", "smm_flip", "LR once"),
-             ("lr_usavg", "smm_flip_usavg", "LR (USAVG)"), ("lr_once_usavg", "smm_flip_usavg", "LR once (USAVG)")]
+             ("lr_usavg", "smm_flip_usavg", "LR (USAVG)"), ("lr_once_usavg", "smm_flip_usavg", "LR once (USAVG)"),
+             ("lr_xpic5_usavg", "smm_xpic5_usavg", "LR-XPIC(5) (USAVG)")]
     try:
         import matplotlib
         matplotlib.use("Agg")

@@ -109,6 +109,13 @@ History run(bool two, XNormals nm, XSeparation sep, XUpdate up, int passes, cons
             XStrainUpdate su = XStrainUpdate::USF) {
   TwoBlocks tb;
   tb.two_classes = two;
+  if (const char* law = std::getenv("BFEMP_B1_LAW")) {  // diagnostics: stick | frictionless | coulomb (default)
+    const std::string l = law;
+    if (l != "stick" && l != "frictionless" && l != "coulomb")
+      throw std::invalid_argument("BFEMP_B1_LAW = '" + l + "': expected stick, frictionless or coulomb");
+    tb.law.law = l == "stick" ? xmpm::ContactLaw::Stick
+                 : l == "frictionless" ? xmpm::ContactLaw::Frictionless : xmpm::ContactLaw::Coulomb;
+  }
   ExplicitSetup<2> s = tb.setup();
   s.strain_update = su;
   s.normals = nm;
@@ -277,14 +284,36 @@ TEST(ExplicitB1, LROnceWorseThanTwicePassesTo20Percent) {
   EXPECT_GT(e_once, e_lr);
 }
 
-// KNOWN GAP (disabled; run with --gtest_also_run_disabled_tests): single-material
-// XPIC(5) now reaches 20 % (the position update, see the top of the file), but
-// LR + XPIC(5) loses the interface near 6 % (the d_LR ~ 0 knife edge; before the
-// position fix near 9-13 %); measured 1.52 % at 10 % strain by the first
-// implementation, against the band 0.3 % (paper 0.24 %).
+// LR + XPIC(5) with the strain update USAVG (NairnMPM's default family; the
+// paper does not say which it used): with USF it loses the interface near 6 %
+// (the d_LR ~ 0 knife edge, top of the file); with USAVG both runs reach 20 %
+// and the interface holds (measured 2026-12-04, OMP_NUM_THREADS=1, dt 0.9:
+// max error 0.911 %; +0.12/+0.06/+0.03/+0.26/+0.37/+0.91/+0.73/+0.72/+0.76 %
+// at 1/2/5/8/10/12/15/18/20 % strain). This test asserts stability and the
+// FLIP-size error (< 1 %, LR's own band); the paper's XPIC band (< 0.3 %) is
+// the disabled test below. Where the error comes from, by the contact law of
+// the same run (BFEMP_B1_LAW): stick 0.002 % (the multimaterial XPIC
+// reverts to single-material mode, Eq. 47), frictionless 2.21 %, Coulomb 0.2
+// 0.91 %: the interface's tangential slip. Lagging pass 1's friction limit
+// with the previous step's pass-2 normal impulse (an experiment, not kept)
+// changed it to 1.00 %, so pass 1's small normal impulse is not the cause.
+TEST(ExplicitB1, LRXpic5WithUsavgReachesTwentyPercent) {
+  const XStrainUpdate su = XStrainUpdate::USAVG;
+  const History smm5 = run(false, XNormals::LR, XSeparation::Velocity, XUpdate::XPIC, 2, "smm_xpic5_usavg", su);
+  const History lr5 = run(true, XNormals::LR, XSeparation::Velocity, XUpdate::XPIC, 2, "lr_xpic5_usavg", su);
+  EXPECT_GT(smm5.reached, B1_END_STRAIN - 1e-3) << smm5.failure;
+  EXPECT_GT(lr5.reached, B1_END_STRAIN - 1e-3) << lr5.failure;
+  EXPECT_LT(max_error(lr5, smm5, 0.005, "LR+XPIC(5) USAVG"), 1.0);
+}
+
+// KNOWN GAP (disabled; run with --gtest_also_run_disabled_tests): the paper's
+// LR + XPIC(5) band, 0.3 % (paper 0.24 %). With USAVG (above) 0.911 % at
+// 12 % strain, below 0.3 % only to 8 %; with USF the run loses the interface
+// near 6 % (189 %).
 TEST(ExplicitB1, DISABLED_XpicStressErrorBelow0p3Percent) {
-  const History smm5 = run(false, XNormals::LR, XSeparation::Velocity, XUpdate::XPIC, 2, "smm_xpic5");
-  const History lr5 = run(true, XNormals::LR, XSeparation::Velocity, XUpdate::XPIC, 2, "lr_xpic5");
+  const XStrainUpdate su = XStrainUpdate::USAVG;
+  const History smm5 = run(false, XNormals::LR, XSeparation::Velocity, XUpdate::XPIC, 2, "smm_xpic5_usavg", su);
+  const History lr5 = run(true, XNormals::LR, XSeparation::Velocity, XUpdate::XPIC, 2, "lr_xpic5_usavg", su);
   EXPECT_GT(smm5.reached, B1_END_STRAIN - 1e-3) << smm5.failure;
   EXPECT_GT(lr5.reached, B1_END_STRAIN - 1e-3) << lr5.failure;
   EXPECT_LT(max_error(lr5, smm5, 0.005, "LR+XPIC(5)"), 0.3);
@@ -294,7 +323,8 @@ TEST(ExplicitB1, DISABLED_XpicStressErrorBelow0p3Percent) {
 // lr_once | smm_xpic5 | lr_pic | lr_xpic5 runs that variant alone, with the
 // strain update USF, or USL / USAVG with a suffix _usl / _usavg (e.g.
 // lr_once_usavg); BFEMP_B1_TRACE=1 prints the particle extent every 0.5 %
-// strain; BFEMP_B1_END_STRAIN overrides the end.
+// strain; BFEMP_B1_END_STRAIN overrides the end; BFEMP_B1_LAW = stick |
+// frictionless replaces the Coulomb law.
 TEST(ExplicitB1, DISABLED_OneVariant) {
   const char* e = std::getenv("BFEMP_B1_VARIANT");
   const std::string w = e ? e : "lr";
