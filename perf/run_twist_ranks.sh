@@ -10,6 +10,8 @@
 # import, particle migration: comm_share) and in output, as JSON that
 # perf/compare.py reads (solver = the configuration, threads = ranks x threads):
 #   perf/run_twist_ranks.sh [--build-dir DIR] [--out FILE] [--steps N] [--precs "RELAXATION BLOCK_CHOLMOD"]
+# (--precs: Ifpack2 names, MUELU, BLOCK_CHOLMOD (its defaults: 'block overlap' 1, 'block reuse'),
+# BLOCK_CHOLMOD_NOREUSE ('block reuse' false), BLOCK_CHOLMOD_OV0 (overlap 0, no reuse: before 2026-12-04))
 #                           [--size NAME --set KEY=VALUE ...]
 # --set changes the scene for every run (e.g. a refined twist for weak
 # scaling: --size twist_weak2 --set 'MPM/grid spacing=0.1'
@@ -59,7 +61,13 @@ run() {  # name ranks threads [bfemp args...]
 run cholmod_1x1 1 1
 run cholmod_1x2 1 2
 for p in $precs; do
-  run "cg_$p" 2 1 --set 'Linear Solver/type=CG' --set "Linear Solver/CG/preconditioner=$p"
+  case "$p" in  # BLOCK_CHOLMOD variants: the defaults (overlap 1, reuse) or one of them off
+    BLOCK_CHOLMOD_OV0) run "cg_$p" 2 1 --set 'Linear Solver/type=CG' --set "Linear Solver/CG/preconditioner=BLOCK_CHOLMOD" \
+      --set "Linear Solver/CG/block overlap=0" --set "Linear Solver/CG/block reuse=false" ;;
+    BLOCK_CHOLMOD_NOREUSE) run "cg_$p" 2 1 --set 'Linear Solver/type=CG' --set "Linear Solver/CG/preconditioner=BLOCK_CHOLMOD" \
+      --set "Linear Solver/CG/block reuse=false" ;;
+    *) run "cg_$p" 2 1 --set 'Linear Solver/type=CG' --set "Linear Solver/CG/preconditioner=$p" ;;
+  esac
 done
 mkdir -p "$(dirname "$out")"
 python3 - "$out" "$repo" "$size" "${runs[@]}" <<'PY'

@@ -2,8 +2,10 @@
 
 #include <Teuchos_CommHelpers.hpp>
 #include <Tpetra_CrsMatrix.hpp>
+#include <Tpetra_Import.hpp>
 #include <Tpetra_MultiVector.hpp>
 #include <algorithm>
+#include <stdexcept>
 #include <cholmod.h>
 #include <string>
 #include <utility>
@@ -29,6 +31,17 @@ struct BlockCholmod::Impl {
   Kokkos::View<double*, MemSpace> values;         // the block's values, gathered by compute()
   bool analysed = false;
   bool factored = false;
+  // Overlap 1 (n_ghost > 0): the ghost rows (imported from their owners into
+  // a matrix on ghost_map with a fixed graph), the block's entries from them
+  // (after the owned rows' n_from_A entries), and the vectors of apply().
+  LO n_own = 0, n_ghost = 0;
+  std::size_t n_from_A = 0;
+  Teuchos::RCP<const Map> ghost_map;
+  Teuchos::RCP<const Tpetra::Import<LO, GO, Node>> ghost_import;  // owned rows -> ghosts
+  Teuchos::RCP<Matrix> ghost_rows;
+  Kokkos::View<std::size_t*, MemSpace> ghost_source;  // per ghost-row entry: its index in ghost_rows' values
+  mutable Teuchos::RCP<MultiVec> xg, sg, yadd;         // apply(): ghost residual, ghost solution, their sum
+  Kokkos::View<double*, MemSpace> rhs;                 // apply(): [owned; ghosts], contiguous for CHOLMOD
 
   Impl() {
     cholmod_l_start(&c);
@@ -47,24 +60,46 @@ struct BlockCholmod::Impl {
 };
 
 // Once per graph (host): which of A's entries lie in this rank's block, in
-// block coordinates (row local ids), sorted per row.
-BlockCholmod::BlockCholmod(const Teuchos::RCP<const Matrix>& A) : impl_(new Impl) {
+// block coordinates (owned rows by local id, then the ghosts), sorted per row.
+BlockCholmod::BlockCholmod(const Teuchos::RCP<const Matrix>& A, int overlap) : impl_(new Impl) {
+  if (overlap != 0 && overlap != 1)
+    throw std::invalid_argument("BlockCholmod: overlap " + std::to_string(overlap) + "; expected 0 or 1");
   auto& m = *impl_;
   m.A = A;
   const auto& rows = *A->getRowMap();
   const auto& cols = *A->getColMap();
   const auto lcl = A->getLocalMatrixHost();
-  const std::size_t n = rows.getNodeNumElements();
-  std::vector<LO> col_to_row(cols.getNodeNumElements());
-  for (std::size_t k = 0; k < col_to_row.size(); ++k) col_to_row[k] = rows.getLocalElement(cols.getGlobalElement(k));
+  const LO invalid = Teuchos::OrdinalTraits<LO>::invalid();
+  m.n_own = static_cast<LO>(rows.getNodeNumElements());
+  // Overlap 1: the ghosts are A's columns this rank does not own.
+  std::vector<GO> ghosts;
+  if (overlap == 1 && A->getComm()->getSize() > 1)
+    for (std::size_t k = 0; k < cols.getNodeNumElements(); ++k)
+      if (rows.getLocalElement(cols.getGlobalElement(k)) == invalid) ghosts.push_back(cols.getGlobalElement(k));
+  m.ghost_map = Teuchos::rcp(new Map(Teuchos::OrdinalTraits<Tpetra::global_size_t>::invalid(),
+                                     Teuchos::ArrayView<const GO>(ghosts), 0, A->getComm()));
+  m.n_ghost = static_cast<LO>(ghosts.size());
+  const bool any_overlap = [&] {  // collective: every rank builds the import, or none
+    int mine = overlap == 1 && A->getComm()->getSize() > 1 ? 1 : 0, any = 0;
+    Teuchos::reduceAll(*A->getComm(), Teuchos::REDUCE_MAX, mine, Teuchos::outArg(any));
+    return any != 0;
+  }();
+  // Block index of a global DOF (owned: its row id; ghost: n_own + ghost id), or -1.
+  auto block_index = [&](GO g) -> LO {
+    const LO r = rows.getLocalElement(g);
+    if (r != invalid) return r;
+    const LO k = m.n_ghost > 0 ? m.ghost_map->getLocalElement(g) : invalid;
+    return k == invalid ? -1 : m.n_own + k;
+  };
+  const std::size_t n = static_cast<std::size_t>(m.n_own + m.n_ghost);
   m.p.assign(n + 1, 0);
-  std::vector<std::pair<LO, std::size_t>> row;  // (block column, index in A's values)
+  std::vector<std::pair<LO, std::size_t>> row;  // (block column, index in the source's values)
   std::vector<std::size_t> src;
-  for (std::size_t r = 0; r < n; ++r) {
+  for (LO r = 0; r < m.n_own; ++r) {
     row.clear();
     for (auto k = lcl.graph.row_map(r); k < lcl.graph.row_map(r + 1); ++k) {
-      const LO c = col_to_row[lcl.graph.entries(k)];
-      if (c != Teuchos::OrdinalTraits<LO>::invalid()) row.emplace_back(c, k);
+      const LO c = block_index(cols.getGlobalElement(lcl.graph.entries(k)));
+      if (c >= 0) row.emplace_back(c, k);
     }
     std::sort(row.begin(), row.end());
     for (const auto& [c, k] : row) {
@@ -73,11 +108,45 @@ BlockCholmod::BlockCholmod(const Teuchos::RCP<const Matrix>& A) : impl_(new Impl
     }
     m.p[r + 1] = static_cast<SuiteSparse_long>(m.i.size());
   }
+  m.n_from_A = src.size();
+  std::vector<std::size_t> gsrc;
+  if (any_overlap) {
+    m.ghost_import = Teuchos::rcp(new Tpetra::Import<LO, GO, Node>(A->getRowMap(), m.ghost_map));
+    Teuchos::RCP<Matrix> imported;
+    A->importAndFillComplete(imported, *m.ghost_import, A->getDomainMap(), A->getRangeMap());
+    m.ghost_rows = Teuchos::rcp(new Matrix(imported->getCrsGraph()));  // fixed graph: values re-imported
+    m.ghost_rows->fillComplete(A->getDomainMap(), A->getRangeMap());
+    const auto gl = imported->getLocalMatrixHost();
+    const auto& gcols = *imported->getColMap();
+    const auto& grows = *imported->getRowMap();
+    for (LO k = 0; k < m.n_ghost; ++k) {
+      const LO r = grows.getLocalElement(m.ghost_map->getGlobalElement(k));
+      row.clear();
+      for (auto e = gl.graph.row_map(r); e < gl.graph.row_map(r + 1); ++e) {
+        const LO c = block_index(gcols.getGlobalElement(gl.graph.entries(e)));
+        if (c >= 0) row.emplace_back(c, e);
+      }
+      std::sort(row.begin(), row.end());
+      for (const auto& [c, e] : row) {
+        m.i.push_back(c);
+        gsrc.push_back(e);
+      }
+      m.p[m.n_own + k + 1] = static_cast<SuiteSparse_long>(m.i.size());
+    }
+    m.xg = Teuchos::rcp(new MultiVec(m.ghost_map, 1));
+    m.sg = Teuchos::rcp(new MultiVec(m.ghost_map, 1));
+    m.yadd = Teuchos::rcp(new MultiVec(A->getRowMap(), 1));
+  }
   m.source = Kokkos::View<std::size_t*, MemSpace>("block_cholmod_source", src.size());
   auto hs = Kokkos::create_mirror_view(m.source);
   for (std::size_t k = 0; k < src.size(); ++k) hs(k) = src[k];
   Kokkos::deep_copy(m.source, hs);
-  m.values = Kokkos::View<double*, MemSpace>("block_cholmod_values", src.size());
+  m.ghost_source = Kokkos::View<std::size_t*, MemSpace>("block_cholmod_ghost_source", gsrc.size());
+  auto hg = Kokkos::create_mirror_view(m.ghost_source);
+  for (std::size_t k = 0; k < gsrc.size(); ++k) hg(k) = gsrc[k];
+  Kokkos::deep_copy(m.ghost_source, hg);
+  m.values = Kokkos::View<double*, MemSpace>("block_cholmod_values", m.i.size());
+  m.rhs = Kokkos::View<double*, MemSpace>("block_cholmod_rhs", n);
 }
 
 BlockCholmod::~BlockCholmod() = default;
@@ -88,8 +157,19 @@ void BlockCholmod::compute() {
   const auto src = m.source;
   const auto vals = m.values;
   Kokkos::parallel_for(
-      "block_cholmod_gather", Kokkos::RangePolicy<ExecSpace>(0, vals.extent(0)),
+      "block_cholmod_gather", Kokkos::RangePolicy<ExecSpace>(0, src.extent(0)),
       KOKKOS_LAMBDA(const std::size_t k) { vals(k) = all(src(k)); });
+  if (!m.ghost_rows.is_null()) {  // the ghost rows' current values from their owners
+    m.ghost_rows->resumeFill();
+    m.ghost_rows->doImport(*m.A, *m.ghost_import, Tpetra::REPLACE);
+    m.ghost_rows->fillComplete(m.A->getDomainMap(), m.A->getRangeMap());
+    const auto gv = m.ghost_rows->getLocalMatrixDevice().values;
+    const auto gsrc = m.ghost_source;
+    const std::size_t off = m.n_from_A;
+    Kokkos::parallel_for(
+        "block_cholmod_gather_ghosts", Kokkos::RangePolicy<ExecSpace>(0, gsrc.extent(0)),
+        KOKKOS_LAMBDA(const std::size_t k) { vals(off + k) = gv(gsrc(k)); });
+  }
   Kokkos::fence();
   cholmod_sparse S = m.view();
   int status = CHOLMOD_OK;
@@ -119,22 +199,59 @@ void BlockCholmod::compute() {
 void BlockCholmod::apply(const MultiVec& Xin, MultiVec& Yout, Teuchos::ETransp, double alpha, double beta) const {
   auto& m = *impl_;
   if (!m.factored) throw std::logic_error("BlockCholmod::apply before a successful compute()");
-  const std::size_t n = m.p.size() - 1;
-  const auto xv = Xin.getLocalViewDevice(Tpetra::Access::ReadOnly);
-  auto yv = Yout.getLocalViewDevice(Tpetra::Access::ReadWrite);
+  const std::size_t n_own = static_cast<std::size_t>(m.n_own), n = m.p.size() - 1;
+  const bool ov = !m.ghost_import.is_null();
   for (std::size_t col = 0; col < Xin.getNumVectors(); ++col) {
-    if (n == 0) break;
-    cholmod_dense B = dense_column_view(const_cast<double*>(&xv(0, col)), n);  // LayoutLeft: contiguous
-    if (!cholmod_l_solve2(CHOLMOD_A, m.L, &B, nullptr, &m.X, nullptr, &m.Y, &m.E, &m.c) || m.c.status != CHOLMOD_OK)
-      throw SolverError("block Cholesky preconditioner (BLOCK_CHOLMOD): CHOLMOD solve status " +
-                        std::to_string(m.c.status));
-    const double* s = static_cast<const double*>(m.X->x);
-    Kokkos::parallel_for(
-        "block_cholmod_apply", Kokkos::RangePolicy<ExecSpace>(0, n), KOKKOS_LAMBDA(const std::size_t k) {
-          yv(k, col) = beta == 0.0 ? alpha * s[k] : alpha * s[k] + beta * yv(k, col);
-        });
+    // The right-hand side on the block: owned entries, then (overlap) the ghosts' from their owners.
+    const auto rhs = m.rhs;
+    {
+      const auto xv = Xin.getLocalViewDevice(Tpetra::Access::ReadOnly);
+      Kokkos::parallel_for(
+          "block_cholmod_rhs", Kokkos::RangePolicy<ExecSpace>(0, n_own),
+          KOKKOS_LAMBDA(const std::size_t k) { rhs(k) = xv(k, col); });
+    }
+    if (ov) {
+      m.xg->doImport(*Xin.getVector(col), *m.ghost_import, Tpetra::INSERT);
+      const auto gv = m.xg->getLocalViewDevice(Tpetra::Access::ReadOnly);
+      Kokkos::parallel_for(
+          "block_cholmod_rhs_ghosts", Kokkos::RangePolicy<ExecSpace>(0, n - n_own),
+          KOKKOS_LAMBDA(const std::size_t k) { rhs(n_own + k) = gv(k, 0); });
+    }
+    Kokkos::fence();
+    const double* s = nullptr;
+    if (n > 0) {
+      cholmod_dense B = dense_column_view(rhs.data(), n);
+      if (!cholmod_l_solve2(CHOLMOD_A, m.L, &B, nullptr, &m.X, nullptr, &m.Y, &m.E, &m.c) || m.c.status != CHOLMOD_OK)
+        throw SolverError("block Cholesky preconditioner (BLOCK_CHOLMOD): CHOLMOD solve status " +
+                          std::to_string(m.c.status));
+      s = static_cast<const double*>(m.X->x);
+    }
+    if (ov) {  // the ghosts' parts of the local solution, added into their owners
+      {
+        auto sv = m.sg->getLocalViewDevice(Tpetra::Access::OverwriteAll);
+        Kokkos::parallel_for(
+            "block_cholmod_ghost_solution", Kokkos::RangePolicy<ExecSpace>(0, n - n_own),
+            KOKKOS_LAMBDA(const std::size_t k) { sv(k, 0) = s[n_own + k]; });
+      }
+      m.yadd->putScalar(0.0);
+      m.yadd->doExport(*m.sg, *m.ghost_import, Tpetra::ADD);
+    }
+    auto yv = Yout.getLocalViewDevice(Tpetra::Access::ReadWrite);
+    if (ov) {
+      const auto av = m.yadd->getLocalViewDevice(Tpetra::Access::ReadOnly);
+      Kokkos::parallel_for(
+          "block_cholmod_apply", Kokkos::RangePolicy<ExecSpace>(0, n_own), KOKKOS_LAMBDA(const std::size_t k) {
+            const double z = s[k] + av(k, 0);
+            yv(k, col) = beta == 0.0 ? alpha * z : alpha * z + beta * yv(k, col);
+          });
+    } else {
+      Kokkos::parallel_for(
+          "block_cholmod_apply", Kokkos::RangePolicy<ExecSpace>(0, n_own), KOKKOS_LAMBDA(const std::size_t k) {
+            yv(k, col) = beta == 0.0 ? alpha * s[k] : alpha * s[k] + beta * yv(k, col);
+          });
+    }
+    Kokkos::fence();
   }
-  Kokkos::fence();
 }
 
 Teuchos::RCP<const Map> BlockCholmod::getDomainMap() const { return impl_->A->getDomainMap(); }

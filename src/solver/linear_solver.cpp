@@ -1,5 +1,8 @@
 #include "solver/linear_solver.hpp"
 
+#include <algorithm>
+#include <cmath>
+
 #include <Amesos2.hpp>
 #include <BelosLinearProblem.hpp>
 #include <BelosPseudoBlockCGSolMgr.hpp>
@@ -120,6 +123,16 @@ Teuchos::RCP<const Teuchos::ParameterList> linear_solver_schema() {
       Teuchos::tuple<std::string>(kPrecNames[0], kPrecNames[1], kPrecNames[2], kPrecNames[3],
                                   kPrecNames[4], kPrecNames[5], kPrecNames[6]),
       &cg);
+  cg.set("block overlap", 1,
+         "BLOCK_CHOLMOD: 0, each rank factorises its owned rows (block Jacobi); 1, its owned rows "
+         "and the ghost rows they couple to (additive Schwarz: fewer CG iterations on several "
+         "ranks, a larger factor and one more exchange per CG iteration)",
+         rcp(new Teuchos::EnhancedNumberValidator<int>(0, 1)));
+  cg.set("block reuse", true,
+         "BLOCK_CHOLMOD: keep a rank's factor across the Newton iterations of a time step and "
+         "refactorise only when the CG iterations the stale factor has cost since its "
+         "factorisation (against the rate right after it) outweigh one factorisation; false: "
+         "factorise at every solve");
   auto& ifp = cg.sublist("Ifpack2", false,
                          "parameters passed to the Ifpack2 preconditioner (checked by bfemp)");
   ifp.disableRecursiveValidation();
@@ -171,6 +184,14 @@ struct LinearSolver::Impl {
   bool adaptive = true;
   int cg_max_iters = 2000;
   int muelu_rebuild_every = 10;
+  int block_overlap = 1;
+  // BLOCK_CHOLMOD factor reuse: whether the factor holds A's values of some
+  // earlier solve of this graph and step, the seconds of its factorisation,
+  // the CG iterations per decade of residual reduction right after it, and
+  // the iterations' seconds the stale factor has cost since.
+  bool block_reuse = true;
+  bool block_valid = false;
+  double block_fact_s = 0, block_fresh_rate = 0, block_excess_s = 0;
   CholmodDirect::Reuse reuse;
   RCP<Vector> residual;  // direct solves: the residual check, kept across solves
 };
@@ -204,6 +225,16 @@ LinearSolver::LinearSolver(const ParameterList& params, const RCP<const Comm>& c
   impl_->cg_max_iters = cg.get<int>("max iterations");
   impl_->muelu_rebuild_every = cg.get<int>("MueLu rebuild every");
   impl_->prec_name = cg.get<std::string>("preconditioner");
+  if (cg.isParameter("block overlap")) impl_->block_overlap = cg.get<int>("block overlap");
+  if (cg.isParameter("block reuse")) impl_->block_reuse = cg.get<bool>("block reuse");
+  // BLOCK_CHOLMOD keys away from their defaults would be ignored by another preconditioner: refuse them.
+  if (kind_ == LinearSolverKind::CG && impl_->prec_name != "BLOCK_CHOLMOD" &&
+      (impl_->block_overlap != 1 || !impl_->block_reuse))
+    throw std::invalid_argument(std::string("scene key 'Linear Solver/CG/") +
+                                (impl_->block_overlap != 1 ? "block overlap' = " + std::to_string(impl_->block_overlap)
+                                                           : std::string("block reuse' = false")) +
+                                " but 'Linear Solver/CG/preconditioner' is " + impl_->prec_name +
+                                ": expected BLOCK_CHOLMOD for it, or the key left at its default");
   impl_->ifpack2 = cg.sublist("Ifpack2");
   if (impl_->prec_name == "SCHWARZ" && !impl_->ifpack2.isParameter("schwarz: combine mode"))
     impl_->ifpack2.set("schwarz: combine mode", "ADD");  // 13.2 default (ZERO) is non-symmetric
@@ -271,6 +302,7 @@ std::string LinearSolver::describe() const {
 
 void LinearSolver::forget_factor() {
   if (impl_->cholmod) impl_->cholmod->forget_factor();
+  impl_->block_valid = false;
 }
 
 void LinearSolver::set_matrix(const RCP<const Matrix>& A) {
@@ -282,7 +314,8 @@ void LinearSolver::set_matrix(const RCP<const Matrix>& A) {
     if (m.muelu) {
       m.muelu->set_matrix(A);
     } else if (m.prec_name == "BLOCK_CHOLMOD") {
-      m.block = rcp(new BlockCholmod(A));
+      m.block = rcp(new BlockCholmod(A, m.block_overlap));
+      m.block_valid = false;
     } else if (m.prec_name != "NONE") {
       m.prec = Ifpack2::Factory::create<Tpetra::RowMatrix<double, LO, GO, Node>>(m.prec_name, A);
       try {
@@ -361,7 +394,22 @@ LinearSolveStats LinearSolver::solve(const Vector& b, Vector& x, double forcing)
     }
     M = m.muelu->op();
   } else if (!m.block.is_null()) {
-    m.block->compute();
+    // Ski rental: refactorise once the extra CG iterations on the stale
+    // factor have cost as much as a factorisation.
+    const bool fresh = !m.block_reuse || !m.block_valid || m.block_excess_s >= m.block_fact_s;
+    if (fresh) {
+      m.block_valid = false;
+      Kokkos::Timer t;
+      m.block->compute();  // throws NotPositiveDefinite on every rank if a block is indefinite
+      m.block_fact_s = t.seconds();
+      {  // the same decision on every rank (the timings differ)
+        const double mine = m.block_fact_s;
+        Teuchos::reduceAll(*m.comm, Teuchos::REDUCE_MAX, mine, Teuchos::outArg(m.block_fact_s));
+      }
+      m.block_valid = true;
+      m.block_excess_s = 0;
+      stats.factorised = true;
+    }
     M = m.block;
   } else if (!m.prec.is_null()) {
     if (m.reinitialise_each_compute) m.prec->initialize();
@@ -383,6 +431,7 @@ LinearSolveStats LinearSolver::solve(const Vector& b, Vector& x, double forcing)
   problem->setProblem();
   Belos::PseudoBlockCGSolMgr<double, MultiVec, Operator> cg(problem, bp);
   Belos::ReturnType ret;
+  Kokkos::Timer cg_timer;
   try {
     ret = cg.solve();
   } catch (const std::exception& e) {
@@ -396,6 +445,19 @@ LinearSolveStats LinearSolver::solve(const Vector& b, Vector& x, double forcing)
   }
   stats.iterations = cg.getNumIters();
   stats.achieved_tol = cg.achievedTol();
+  if (!m.block.is_null() && m.block_reuse && ret == Belos::Converged && stats.iterations > 0) {
+    // CG iterations per decade of residual reduction, fresh factor against stale
+    const double decades = std::max(1.0, -std::log10(std::max(stats.achieved_tol, 1e-300)));
+    const double rate = stats.iterations / decades;
+    if (stats.factorised) {
+      m.block_fresh_rate = rate;
+    } else {
+      double per_it = cg_timer.seconds() / stats.iterations;
+      const double mine = per_it;
+      Teuchos::reduceAll(*m.comm, Teuchos::REDUCE_MAX, mine, Teuchos::outArg(per_it));
+      m.block_excess_s += std::max(0.0, (rate - m.block_fresh_rate) * decades) * per_it;
+    }
+  }
   if (ret != Belos::Converged) {
     std::ostringstream msg;
     msg << "CG did not converge: " << stats.iterations << " iterations, relative residual "
