@@ -31,6 +31,7 @@ struct BlockCholmod::Impl {
   Kokkos::View<double*, MemSpace> values;         // the block's values, gathered by compute()
   bool analysed = false;
   bool factored = false;
+  double fl = 0, lnz = 0;  // CHOLMOD's analysis: factorisation flops, nonzeros of L
   // Overlap 1 (n_ghost > 0): the ghost rows (imported from their owners into
   // a matrix on ghost_map with a fixed graph), the block's entries from them
   // (after the owned rows' n_from_A entries), and the vectors of apply().
@@ -177,6 +178,8 @@ void BlockCholmod::compute() {
     m.L = cholmod_l_analyze(&S, &m.c);
     status = m.L ? m.c.status : CHOLMOD_INVALID;
     m.analysed = m.L != nullptr;
+    m.fl = m.c.fl;
+    m.lnz = m.c.lnz;
   }
   m.factored = false;
   if (status >= CHOLMOD_OK && S.nrow > 0) {
@@ -256,6 +259,10 @@ void BlockCholmod::apply(const MultiVec& Xin, MultiVec& Yout, Teuchos::ETransp, 
 
 Teuchos::RCP<const Map> BlockCholmod::getDomainMap() const { return impl_->A->getDomainMap(); }
 Teuchos::RCP<const Map> BlockCholmod::getRangeMap() const { return impl_->A->getRangeMap(); }
+double BlockCholmod::factor_flops() const { return impl_->fl; }
+double BlockCholmod::iteration_flops() const {
+  return 4.0 * impl_->lnz + 2.0 * static_cast<double>(impl_->A->getNodeNumEntries());
+}
 std::size_t BlockCholmod::block_rows() const { return impl_->p.size() - 1; }
 std::size_t BlockCholmod::block_entries() const { return impl_->i.size(); }
 

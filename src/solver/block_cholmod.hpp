@@ -56,6 +56,13 @@ class BlockCholmod : public Operator {
   Teuchos::RCP<const Map> getDomainMap() const override;
   Teuchos::RCP<const Map> getRangeMap() const override;
 
+  // Cost model (flops, this rank; after the first compute()): one numeric
+  // factorisation (CHOLMOD's count from the analysis), and one CG iteration
+  // with this preconditioner (two triangular solves, 4 nnz(L), and the
+  // product with A's local rows, 2 nnz). Deterministic, unlike timings.
+  double factor_flops() const;
+  double iteration_flops() const;
+
   // This rank's block: rows (owned, plus ghosts with overlap 1) and stored
   // entries (both triangles).
   std::size_t block_rows() const;

@@ -109,12 +109,15 @@ Teuchos::RCP<const Teuchos::ParameterList> linear_solver_schema() {
          rcp(new Teuchos::EnhancedNumberValidator<int>(1, 1000000)));
   cg.set("max iterations", 2000, "CG iteration cap; reaching it is an error",
          rcp(new Teuchos::EnhancedNumberValidator<int>(1, 1000000)));
-  // Default RELAXATION, by measurement (perf/README.md): MUELU is 5x faster
-  // on FEM-only blocks (1e5 DOFs, 2D), but MPM scenes change the graph every
-  // step and pay a new hierarchy each time (A1 ci rings: linear solve 44 s
-  // with MUELU against 5.7 s with RELAXATION; A7 ci: 11.9 s against 11.7 s).
+  // Default BLOCK_CHOLMOD, by measurement (perf/README.md): on the 3D twist
+  // on 2 ranks (overlap 1 with reuse) 1.56 s per contact step against 6.63 s
+  // with RELAXATION at the ci size, 3.82 s against 11.63 s weak-scaled; on 1
+  // rank it is one CG iteration on a Cholesky factor. MUELU (5x faster than
+  // RELAXATION on FEM-only 2D blocks of 1e5 DOFs) pays a new hierarchy each
+  // step where MPM bodies change the graph (A1 ci rings: linear solve 44 s
+  // against 5.7 s with RELAXATION).
   Teuchos::setStringToIntegralParameter<int>(
-      "preconditioner", "RELAXATION",
+      "preconditioner", "BLOCK_CHOLMOD",
       "an Ifpack2 preconditioner (RELAXATION, CHEBYSHEV, RILUK, SCHWARZ), MUELU (algebraic "
       "multigrid on the rigid-body modes of the nodes: the fastest for FEM-only scenes, slow "
       "where the graph changes every step, as with MPM bodies), BLOCK_CHOLMOD (an exact "
@@ -186,12 +189,14 @@ struct LinearSolver::Impl {
   int muelu_rebuild_every = 10;
   int block_overlap = 1;
   // BLOCK_CHOLMOD factor reuse: whether the factor holds A's values of some
-  // earlier solve of this graph and step, the seconds of its factorisation,
-  // the CG iterations per decade of residual reduction right after it, and
-  // the iterations' seconds the stale factor has cost since.
+  // earlier solve of this graph and step, a factorisation's cost in CG
+  // iterations (flop counts, the costliest rank's), the CG iterations per
+  // decade of residual reduction right after it, and the extra iterations the
+  // stale factor has cost since. Counts, not timings: a run decides alike
+  // every time.
   bool block_reuse = true;
   bool block_valid = false;
-  double block_fact_s = 0, block_fresh_rate = 0, block_excess_s = 0;
+  double block_fact_its = 0, block_fresh_rate = 0, block_excess_its = 0;
   CholmodDirect::Reuse reuse;
   RCP<Vector> residual;  // direct solves: the residual check, kept across solves
 };
@@ -396,18 +401,18 @@ LinearSolveStats LinearSolver::solve(const Vector& b, Vector& x, double forcing)
   } else if (!m.block.is_null()) {
     // Ski rental: refactorise once the extra CG iterations on the stale
     // factor have cost as much as a factorisation.
-    const bool fresh = !m.block_reuse || !m.block_valid || m.block_excess_s >= m.block_fact_s;
+    const bool fresh = !m.block_reuse || !m.block_valid || m.block_excess_its >= m.block_fact_its;
     if (fresh) {
       m.block_valid = false;
-      Kokkos::Timer t;
       m.block->compute();  // throws NotPositiveDefinite on every rank if a block is indefinite
-      m.block_fact_s = t.seconds();
-      {  // the same decision on every rank (the timings differ)
-        const double mine = m.block_fact_s;
-        Teuchos::reduceAll(*m.comm, Teuchos::REDUCE_MAX, mine, Teuchos::outArg(m.block_fact_s));
+      {  // the costliest rank's factorisation, in its CG iterations (every rank decides alike)
+        const double mine[2] = {m.block->factor_flops(), m.block->iteration_flops()};
+        double most[2] = {0, 0};
+        Teuchos::reduceAll(*m.comm, Teuchos::REDUCE_MAX, 2, mine, most);
+        m.block_fact_its = most[1] > 0 ? most[0] / most[1] : 0.0;
       }
       m.block_valid = true;
-      m.block_excess_s = 0;
+      m.block_excess_its = 0;
       stats.factorised = true;
     }
     M = m.block;
@@ -431,7 +436,6 @@ LinearSolveStats LinearSolver::solve(const Vector& b, Vector& x, double forcing)
   problem->setProblem();
   Belos::PseudoBlockCGSolMgr<double, MultiVec, Operator> cg(problem, bp);
   Belos::ReturnType ret;
-  Kokkos::Timer cg_timer;
   try {
     ret = cg.solve();
   } catch (const std::exception& e) {
@@ -449,14 +453,8 @@ LinearSolveStats LinearSolver::solve(const Vector& b, Vector& x, double forcing)
     // CG iterations per decade of residual reduction, fresh factor against stale
     const double decades = std::max(1.0, -std::log10(std::max(stats.achieved_tol, 1e-300)));
     const double rate = stats.iterations / decades;
-    if (stats.factorised) {
-      m.block_fresh_rate = rate;
-    } else {
-      double per_it = cg_timer.seconds() / stats.iterations;
-      const double mine = per_it;
-      Teuchos::reduceAll(*m.comm, Teuchos::REDUCE_MAX, mine, Teuchos::outArg(per_it));
-      m.block_excess_s += std::max(0.0, (rate - m.block_fresh_rate) * decades) * per_it;
-    }
+    if (stats.factorised) m.block_fresh_rate = rate;
+    else m.block_excess_its += std::max(0.0, (rate - m.block_fresh_rate) * decades);
   }
   if (ret != Belos::Converged) {
     std::ostringstream msg;

@@ -135,7 +135,7 @@ TEST(MueLu, MisspelledKeyStopsAtConstruction) {
 
 TEST(MueLu, DefaultForCgAndKeysOfTheOtherPreconditionerRefused) {
   Teuchos::ParameterList ls = *linear_solver_schema();
-  EXPECT_EQ(ls.sublist("CG").get<std::string>("preconditioner"), "RELAXATION") << "CG's default, by measurement";
+  EXPECT_EQ(ls.sublist("CG").get<std::string>("preconditioner"), "BLOCK_CHOLMOD") << "CG's default, by measurement";
   ls.set("type", std::string("CG"));
   ls.sublist("CG").set("preconditioner", std::string("MUELU"));
   ls.sublist("CG").sublist("Ifpack2").set("relaxation: sweeps", 2);
