@@ -92,6 +92,9 @@ BlockCholmod::BlockCholmod(const Teuchos::RCP<const Matrix>& A, int overlap) : i
     const LO k = m.n_ghost > 0 ? m.ghost_map->getLocalElement(g) : invalid;
     return k == invalid ? -1 : m.n_own + k;
   };
+  // The block index of each of A's local columns, looked up once (not per entry).
+  std::vector<LO> col_block(cols.getNodeNumElements());
+  for (std::size_t k = 0; k < col_block.size(); ++k) col_block[k] = block_index(cols.getGlobalElement(k));
   const std::size_t n = static_cast<std::size_t>(m.n_own + m.n_ghost);
   m.p.assign(n + 1, 0);
   std::vector<std::pair<LO, std::size_t>> row;  // (block column, index in the source's values)
@@ -99,7 +102,7 @@ BlockCholmod::BlockCholmod(const Teuchos::RCP<const Matrix>& A, int overlap) : i
   for (LO r = 0; r < m.n_own; ++r) {
     row.clear();
     for (auto k = lcl.graph.row_map(r); k < lcl.graph.row_map(r + 1); ++k) {
-      const LO c = block_index(cols.getGlobalElement(lcl.graph.entries(k)));
+      const LO c = col_block[lcl.graph.entries(k)];
       if (c >= 0) row.emplace_back(c, k);
     }
     std::sort(row.begin(), row.end());
@@ -120,11 +123,13 @@ BlockCholmod::BlockCholmod(const Teuchos::RCP<const Matrix>& A, int overlap) : i
     const auto gl = imported->getLocalMatrixHost();
     const auto& gcols = *imported->getColMap();
     const auto& grows = *imported->getRowMap();
+    std::vector<LO> gcol_block(gcols.getNodeNumElements());
+    for (std::size_t k = 0; k < gcol_block.size(); ++k) gcol_block[k] = block_index(gcols.getGlobalElement(k));
     for (LO k = 0; k < m.n_ghost; ++k) {
       const LO r = grows.getLocalElement(m.ghost_map->getGlobalElement(k));
       row.clear();
       for (auto e = gl.graph.row_map(r); e < gl.graph.row_map(r + 1); ++e) {
-        const LO c = block_index(gcols.getGlobalElement(gl.graph.entries(e)));
+        const LO c = gcol_block[gl.graph.entries(e)];
         if (c >= 0) row.emplace_back(c, e);
       }
       std::sort(row.begin(), row.end());
