@@ -91,7 +91,8 @@ void set_values(Matrix& A, double diag, double off) {
 }
 
 // Solves A x = A x_exact with `solver`; the CG iterations and max |x - x_exact|.
-std::pair<int, double> solve_known(LinearSolver& solver, const Matrix& A) {
+// (`stats`, if given, receives the solve's statistics.)
+std::pair<int, double> solve_known(LinearSolver& solver, const Matrix& A, LinearSolveStats* stats = nullptr) {
   Vector xe(A.getRowMap()), b(A.getRowMap()), x(A.getRowMap());
   {
     auto v = xe.getLocalViewHost(Tpetra::Access::OverwriteAll);
@@ -99,6 +100,7 @@ std::pair<int, double> solve_known(LinearSolver& solver, const Matrix& A) {
   }
   A.apply(xe, b);
   const auto st = solver.solve(b, x);
+  if (stats) *stats = st;
   x.update(-1.0, xe, 1.0);
   return {st.iterations, x.normInf()};
 }
@@ -109,6 +111,22 @@ Teuchos::ParameterList cg_with(const std::string& prec) {
   ls.sublist("CG").set("preconditioner", prec);
   ls.sublist("CG").set("tolerance", 1e-12);
   return ls;
+}
+// Makes the diagonal entry of rank 0's local row `row` negative (A is then
+// indefinite) and expects every rank's solve to throw NotPositiveDefinite.
+void expect_indefinite_found(LinearSolver& solver, Matrix& A, LO row) {
+  auto comm = A.getComm();
+  A.resumeFill();
+  if (comm->getRank() == 0) {
+    const GO r = A.getRowMap()->getGlobalElement(row);
+    std::vector<GO> c{r};
+    std::vector<double> v{-1.0};
+    A.replaceGlobalValues(r, Teuchos::ArrayView<const GO>(c), Teuchos::ArrayView<const double>(v));
+  }
+  A.fillComplete();
+  Vector b(A.getRowMap()), x(A.getRowMap());
+  b.putScalar(1.0);
+  EXPECT_THROW(solver.solve(b, x), NotPositiveDefinite) << "on rank " << comm->getRank();
 }
 
 }  // namespace
@@ -160,17 +178,7 @@ TEST(LinearSolverMpi, BlockJacobiFactorsEachRanksBlockWithTheValuesOfSolveTime) 
   }
   // Indefinite: a negative diagonal entry in rank 0's rows only; every rank
   // hears of it (NotPositiveDefinite), so none waits in CG.
-  A->resumeFill();
-  if (comm->getRank() == 0) {
-    const GO r = A->getRowMap()->getGlobalElement(0);
-    std::vector<GO> c{r};
-    std::vector<double> v{-1.0};
-    A->replaceGlobalValues(r, Teuchos::ArrayView<const GO>(c), Teuchos::ArrayView<const double>(v));
-  }
-  A->fillComplete();
-  Vector b(A->getRowMap()), x(A->getRowMap());
-  b.putScalar(1.0);
-  EXPECT_THROW(block.solve(b, x), NotPositiveDefinite) << "on rank " << comm->getRank();
+  expect_indefinite_found(block, *A, 0);
 }
 
 // BLOCK_CHOLMOD with 'block overlap' 1: each rank factorises its owned rows
@@ -217,18 +225,7 @@ TEST(LinearSolverMpi, BlockOverlapOneIsAdditiveSchwarzWithFewerIterations) {
               << " (overlap 0), " << si << " (SCHWARZ overlap 1 + KLU2)\n";
   }
   // The last row of rank 0 is a ghost of rank 1 (the cut): make it indefinite there.
-  A->resumeFill();
-  if (comm->getRank() == 0) {
-    const LO last = static_cast<LO>(A->getRowMap()->getNodeNumElements()) - 1;
-    const GO r = A->getRowMap()->getGlobalElement(last);
-    std::vector<GO> c{r};
-    std::vector<double> v{-1.0};
-    A->replaceGlobalValues(r, Teuchos::ArrayView<const GO>(c), Teuchos::ArrayView<const double>(v));
-  }
-  A->fillComplete();
-  Vector b(A->getRowMap()), x(A->getRowMap());
-  b.putScalar(1.0);
-  EXPECT_THROW(overlap.solve(b, x), NotPositiveDefinite) << "on rank " << comm->getRank();
+  expect_indefinite_found(overlap, *A, static_cast<LO>(A->getRowMap()->getNodeNumElements()) - 1);
 }
 
 // 'block reuse' (the default): a later solve on the same graph keeps the
@@ -244,15 +241,8 @@ TEST(LinearSolverMpi, BlockReuseKeepsTheFactorAcrossSolvesOfOneStep) {
   s.set_matrix(A);
   auto solve = [&](double diag, double off) {
     set_values(*A, diag, off);
-    Vector xe(A->getRowMap()), b(A->getRowMap()), x(A->getRowMap());
-    {
-      auto v = xe.getLocalViewHost(Tpetra::Access::OverwriteAll);
-      for (LO l = 0; l < static_cast<LO>(v.extent(0)); ++l) v(l, 0) = exact(A->getRowMap()->getGlobalElement(l));
-    }
-    A->apply(xe, b);
-    const auto st = s.solve(b, x);
-    x.update(-1.0, xe, 1.0);
-    EXPECT_LT(x.normInf(), 1e-8) << "diagonal " << diag;
+    LinearSolveStats st;
+    EXPECT_LT(solve_known(s, *A, &st).second, 1e-8) << "diagonal " << diag;
     return st;
   };
   EXPECT_TRUE(solve(4.01, 1.0).factorised);
