@@ -72,7 +72,6 @@ LO activate_grid(const GridSpec<dim>& grid, const Particles<dim>& p, LO first,
 template <int dim, class MassScatter, class MomentumScatter>
 void p2g(const GridSpec<dim>& grid, const Particles<dim>& p, TransferScheme scheme,
          Kokkos::View<const LO*, MemSpace> system_node, LO first, MassScatter mass, MomentumScatter momentum) {
-  constexpr int ns = bspline_stencil_size<dim>;
   const bool apic = scheme == TransferScheme::APIC;
   Kokkos::parallel_for(
       "mpm_p2g", Kokkos::RangePolicy<ExecSpace>(0, p.size()), KOKKOS_LAMBDA(const LO q) {
@@ -81,19 +80,24 @@ void p2g(const GridSpec<dim>& grid, const Particles<dim>& p, TransferScheme sche
         const Vec<dim> xp = particle_position(p, q);
         const auto st = bspline_stencil(grid, xp);
         const double mp = p.mass(q);
-        for (int a = 0; a < ns; ++a) {
-          const LO gnode = node_index(grid, st, a);
-          const LO k = system_node(gnode) - first;
-          const double w = weight(st, a);
-          m_acc(k) += w * mp;
-          const Vec<dim> dxi = grid.node_position(gnode) - xp;
-          for (int c = 0; c < dim; ++c) {
-            double v = p.v(q, c);
-            if (apic)
-              for (int d = 0; d < dim; ++d) v += p.C(q, c, d) * dxi(d);
-            p_acc(k * dim + c) += w * mp * v;
-          }
+        Vec<dim> vp;
+        Mat<dim> C = Mat<dim>::Zero();
+        for (int c = 0; c < dim; ++c) {
+          vp(c) = p.v(q, c);
+          if (apic)
+            for (int d = 0; d < dim; ++d) C(c, d) = p.C(q, c, d);
         }
+        for_each_stencil_node<dim>(grid, st, xp, [&](int, LO gnode, double w, const Vec<dim>&, const Vec<dim>& dxi) {
+          const LO k = system_node(gnode) - first;
+          const double wm = w * mp;
+          m_acc(k) += wm;
+          for (int c = 0; c < dim; ++c) {
+            double v = vp(c);
+            if (apic)
+              for (int d = 0; d < dim; ++d) v += C(c, d) * dxi(d);
+            p_acc(k * dim + c) += wm * v;
+          }
+        });
       });
 }
 
@@ -127,7 +131,6 @@ template <int dim>
 void g2p(const GridSpec<dim>& grid, const Particles<dim>& p, TransferScheme scheme,
          Kokkos::View<const LO*, MemSpace> system_node, Kokkos::View<const double*, MemSpace> x_new,
          Kokkos::View<const double*, MemSpace> v_new, Kokkos::View<const double*, MemSpace> v_old) {
-  constexpr int ns = bspline_stencil_size<dim>;
   const double inv_D = 4.0 / (grid.dx * grid.dx);
   Kokkos::parallel_for(
       "mpm_g2p", Kokkos::RangePolicy<ExecSpace>(0, p.size()), KOKKOS_LAMBDA(const LO q) {
@@ -135,31 +138,32 @@ void g2p(const GridSpec<dim>& grid, const Particles<dim>& p, TransferScheme sche
         const auto st = bspline_stencil(grid, xp);
         Vec<dim> xn = Vec<dim>::Zero(), vn = Vec<dim>::Zero(), dv = Vec<dim>::Zero();
         Mat<dim> G = Mat<dim>::Zero();  // sum x~_i grad w^T
-        for (int a = 0; a < ns; ++a) {
-          const LO k = system_node(node_index(grid, st, a));
-          const double w = weight(st, a);
-          const Vec<dim> gw = weight_gradient(st, a);
+        // APIC (Table 1): B = 1/2 sum w [v_i (x_i - x_p + x~_i - x~_p)^T + (x_i - x_p - x~_i + x~_p) v_i^T]
+        // with x~_p = sum w x~_i = xn; the xn terms summed separately (sum w v_i = vn):
+        // B = 1/2 (S1 - vn xn^T + S2 + xn vn^T), S1 = sum w v_i (x_i - x_p + x~_i)^T,
+        // S2 = sum w (x_i - x_p - x~_i) v_i^T. One pass over the stencil.
+        Mat<dim> S = Mat<dim>::Zero();
+        const bool apic = scheme == TransferScheme::APIC;
+        for_each_stencil_node<dim>(grid, st, xp, [&](int, LO gnode, double w, const Vec<dim>& gw, const Vec<dim>& r) {
+          const LO k = system_node(gnode);
+          Vec<dim> xt, vi;
           for (int c = 0; c < dim; ++c) {
-            xn(c) += w * x_new(k * dim + c);
-            vn(c) += w * v_new(k * dim + c);
-            dv(c) += w * (v_new(k * dim + c) - v_old(k * dim + c));
-            for (int j = 0; j < dim; ++j) G(c, j) += x_new(k * dim + c) * gw(j);
+            xt(c) = x_new(k * dim + c);
+            vi(c) = v_new(k * dim + c);
+            dv(c) += w * (vi(c) - v_old(k * dim + c));
           }
-        }
-        if (scheme == TransferScheme::APIC) {
-          Mat<dim> B = Mat<dim>::Zero();
-          for (int a = 0; a < ns; ++a) {
-            const LO gnode = node_index(grid, st, a);
-            const LO k = system_node(gnode);
-            const double w = weight(st, a);
-            Vec<dim> vi, xt;
-            for (int c = 0; c < dim; ++c) {
-              vi(c) = v_new(k * dim + c);
-              xt(c) = x_new(k * dim + c);
+          for (int i = 0; i < dim; ++i) {
+            xn(i) += w * xt(i);
+            vn(i) += w * vi(i);
+            const double wv = w * vi(i), wd = w * (r(i) - xt(i));
+            for (int j = 0; j < dim; ++j) {
+              G(i, j) += xt(i) * gw(j);
+              if (apic) S(i, j) += wv * (r(j) + xt(j)) + wd * vi(j);
             }
-            const Vec<dim> xi = grid.node_position(gnode);
-            B += 0.5 * w * (vi * (xi - xp + xt - xn).transpose() + (xi - xp - xt + xn) * vi.transpose());
           }
+        });
+        if (apic) {
+          const Mat<dim> B = 0.5 * (S - vn * xn.transpose() + xn * vn.transpose());
           for (int i = 0; i < dim; ++i)
             for (int j = 0; j < dim; ++j) p.C(q, i, j) = B(i, j) * inv_D;
         }

@@ -100,4 +100,46 @@ KOKKOS_INLINE_FUNCTION LO node_index(const GridSpec<dim>& grid, const BSplineSte
   return grid.node_index(stencil_node<dim>(s, a));
 }
 
+// Visits the 3^dim nodes of the stencil of a particle at xp in the order of
+// a (x fastest) and calls f(a, node, w, grad_w, r) with the node's linear
+// grid index, w_a, grad w_a (physical units) and r = x_node - xp, from the
+// per-axis tables: no divisions, no index decoding (the same values as
+// node_index, weight, weight_gradient and grid.node_position(node) - xp, up
+// to the rounding of the last).
+template <int dim, class F>
+KOKKOS_INLINE_FUNCTION void for_each_stencil_node(const GridSpec<dim>& grid, const BSplineStencil<dim>& s,
+                                                  const Vec<dim>& xp, F&& f) {
+  double r[dim][3];
+  for (int d = 0; d < dim; ++d)
+    for (int o = 0; o < 3; ++o) r[d][o] = grid.origin[d] + grid.dx * (s.base[d] + o) - xp[d];
+  const LO n0 = grid.nodes_along(0), n01 = n0 * grid.nodes_along(1);
+  GridIndex<dim> b{};
+  for (int d = 0; d < dim; ++d) b[d] = s.base[d];
+  const LO base = grid.node_index(b);
+  int a = 0;
+  for (int o2 = 0; o2 < (dim == 3 ? 3 : 1); ++o2) {
+    double wz = 1.0, dwz = 0.0;
+    if constexpr (dim == 3) {
+      wz = s.w[2][o2];
+      dwz = s.dw[2][o2];
+    }
+    for (int o1 = 0; o1 < 3; ++o1) {
+      const double wyz = s.w[1][o1] * wz;
+      for (int o0 = 0; o0 < 3; ++o0, ++a) {
+        const LO node = base + o0 + n0 * o1 + n01 * o2;
+        Vec<dim> g, rel;
+        g[0] = s.dw[0][o0] * wyz;
+        g[1] = s.w[0][o0] * s.dw[1][o1] * wz;
+        rel[0] = r[0][o0];
+        rel[1] = r[1][o1];
+        if constexpr (dim == 3) {
+          g[2] = s.w[0][o0] * s.w[1][o1] * dwz;
+          rel[2] = r[2][o2];
+        }
+        f(a, node, s.w[0][o0] * wyz, g, rel);
+      }
+    }
+  }
+}
+
 }  // namespace bfemp
