@@ -143,14 +143,14 @@ void g2p(const GridSpec<dim>& grid, const Particles<dim>& p, TransferScheme sche
         // B = 1/2 (S1 - vn xn^T + S2 + xn vn^T), S1 = sum w v_i (x_i - x_p + x~_i)^T,
         // S2 = sum w (x_i - x_p - x~_i) v_i^T. One pass over the stencil.
         Mat<dim> S = Mat<dim>::Zero();
-        const bool apic = scheme == TransferScheme::APIC;
+        const bool apic = scheme == TransferScheme::APIC, flip = scheme == TransferScheme::FLIP;
         for_each_stencil_node<dim>(grid, st, xp, [&](int, LO gnode, double w, const Vec<dim>& gw, const Vec<dim>& r) {
           const LO k = system_node(gnode);
           Vec<dim> xt, vi;
           for (int c = 0; c < dim; ++c) {
             xt(c) = x_new(k * dim + c);
             vi(c) = v_new(k * dim + c);
-            dv(c) += w * (vi(c) - v_old(k * dim + c));
+            if (flip) dv(c) += w * (vi(c) - v_old(k * dim + c));  // v^n is read only by FLIP
           }
           for (int i = 0; i < dim; ++i) {
             xn(i) += w * xt(i);
