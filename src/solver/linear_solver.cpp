@@ -110,8 +110,9 @@ Teuchos::RCP<const Teuchos::ParameterList> linear_solver_schema() {
   cg.set("max iterations", 2000, "CG iteration cap; reaching it is an error",
          rcp(new Teuchos::EnhancedNumberValidator<int>(1, 1000000)));
   // Default BLOCK_CHOLMOD, by measurement (perf/README.md): on the 3D twist
-  // on 2 ranks (overlap 1 with reuse) 1.56 s per contact step against 6.63 s
-  // with RELAXATION at the ci size, 3.82 s against 11.63 s weak-scaled; on 1
+  // on 2 ranks (overlap 1 with reuse) 1.71-1.87 s per contact step against
+  // 6.63-7.38 s with RELAXATION at the ci size, 3.82 s against 11.63 s
+  // weak-scaled; on 1
   // rank it is one CG iteration on a Cholesky factor. MUELU (5x faster than
   // RELAXATION on FEM-only 2D blocks of 1e5 DOFs) pays a new hierarchy each
   // step where MPM bodies change the graph (A1 ci rings: linear solve 44 s
