@@ -457,6 +457,15 @@ LinearSolveStats LinearSolver::solve(const Vector& b, Vector& x, double forcing)
     if (stats.factorised) m.block_fresh_rate = rate;
     else m.block_excess_its += std::max(0.0, (rate - m.block_fresh_rate) * decades);
   }
+  if (ret != Belos::Converged && !m.block.is_null() && !stats.factorised) {
+    // The stale factor was not good enough for these values: refactorise and
+    // solve again from CG's last iterate (a failure then is the solver's).
+    m.block_valid = false;
+    LinearSolveStats again = solve(b, x, forcing);
+    again.iterations += stats.iterations;
+    again.stale_retries += 1;
+    return again;
+  }
   if (ret != Belos::Converged) {
     std::ostringstream msg;
     msg << "CG did not converge: " << stats.iterations << " iterations, relative residual "

@@ -260,6 +260,62 @@ TEST(LinearSolverMpi, BlockReuseKeepsTheFactorAcrossSolvesOfOneStep) {
   EXPECT_TRUE(solve(4.01, 1.0).factorised);
 }
 
+// A kept factor that is too stale for CG's iteration cap is not a failure:
+// the solve is redone on a fresh factor (from CG's last iterate). Measured
+// first with the default cap: the stale solve of the far values needs more
+// iterations than the fresh one; the cap then lies between the two.
+TEST(LinearSolverMpi, BlockReuseRefactorisesWhenTheStaleFactorFails) {
+  auto comm = Tpetra::getDefaultComm();
+  auto A = laplacian(comm);
+  set_values(*A, 0.0, 0.0);
+  const double near[2] = {8.0, 0.2}, far[2] = {4.01, 1.0};
+  int first_its = 0, stale_its = 0, fresh_its = 0;
+  {
+    LinearSolver s(cg_with("BLOCK_CHOLMOD"), comm);
+    s.set_matrix(A);
+    set_values(*A, near[0], near[1]);
+    LinearSolveStats st;
+    solve_known(s, *A, &st);
+    ASSERT_TRUE(st.factorised);
+    first_its = st.iterations;
+    set_values(*A, far[0], far[1]);
+    solve_known(s, *A, &st);
+    ASSERT_FALSE(st.factorised);
+    stale_its = st.iterations;
+    s.forget_factor();
+    solve_known(s, *A, &st);
+    ASSERT_TRUE(st.factorised);
+    fresh_its = st.iterations;
+  }
+  if (comm->getRank() == 0)
+    std::cout << "[ measured ] " << comm->getSize() << " rank(s): fresh " << first_its << ", stale " << stale_its
+            << ", fresh " << fresh_its << std::endl;
+  const int cap = std::max(first_its, fresh_its) + 1;
+  ASSERT_GT(stale_its, cap) << "the stale factor must cost iterations for this test to mean anything";
+  Teuchos::ParameterList ls = cg_with("BLOCK_CHOLMOD");
+  ls.sublist("CG").set("max iterations", cap);
+  LinearSolver s(ls, comm);
+  s.set_matrix(A);
+  set_values(*A, near[0], near[1]);
+  LinearSolveStats st;
+  EXPECT_LT(solve_known(s, *A, &st).second, 1e-8);
+  EXPECT_TRUE(st.factorised);
+  EXPECT_EQ(st.stale_retries, 0);
+  set_values(*A, far[0], far[1]);
+  const double err = solve_known(s, *A, &st).second;  // stale: hits the cap, then fresh
+  EXPECT_LT(err, 1e-8);
+  EXPECT_TRUE(st.factorised);
+  EXPECT_EQ(st.stale_retries, 1);
+  EXPECT_GT(st.iterations, cap);  // both attempts counted
+  // A fresh factor that fails stays an error.
+  if (comm->getSize() > 1) {
+    ls.sublist("CG").set("max iterations", 1);
+    LinearSolver t(ls, comm);
+    t.set_matrix(A);
+    EXPECT_THROW(solve_known(t, *A), SolverError);
+  }
+}
+
 TEST(LinearSolverMpi, BlockOverlapNeedsBlockCholmod) {
   Teuchos::ParameterList ls = cg_with("RELAXATION");
   ls.sublist("CG").set("block overlap", 0);
