@@ -13,6 +13,17 @@
 
 namespace bfemp {
 
+namespace {
+std::vector<std::string> split_commas(const std::string& line) {
+  std::vector<std::string> out(1);
+  for (const char c : line) {
+    if (c == ',') out.emplace_back();
+    else out.back() += c;
+  }
+  return out;
+}
+}  // namespace
+
 DiagnosticsCsv::DiagnosticsCsv(const std::string& path, std::vector<std::string> columns,
                                const std::set<std::string>& integer_columns)
     : path_(path), columns_(std::move(columns)) {
@@ -36,16 +47,34 @@ DiagnosticsCsv::DiagnosticsCsv(const std::string& path, std::vector<std::string>
   std::getline(in, header);
   std::string want;
   for (std::size_t i = 0; i < columns_.size(); ++i) want += (i ? "," : "") + columns_[i];
-  if (header != want) throw std::runtime_error(where + "header '" + header + "' differs from this version's columns");
-  kept = header + "\n";
+  // A file of an older version whose columns are all still here (in any
+  // order): its rows are rewritten in this version's columns, "nan" in the
+  // new ones. Any other header is refused.
+  const std::vector<std::string> had = split_commas(header);
+  std::vector<long> from(columns_.size(), -1);  // column i of this version <- old column from[i]
+  for (std::size_t i = 0; i < columns_.size(); ++i) {
+    const auto it = std::find(had.begin(), had.end(), columns_[i]);
+    if (it != had.end()) from[i] = it - had.begin();
+  }
+  const auto found = static_cast<std::size_t>(std::count_if(from.begin(), from.end(), [](long f) { return f >= 0; }));
+  if (header != want && found != had.size())
+    throw std::runtime_error(where + "header '" + header + "' differs from this version's columns ('" + want +
+                             "') by more than added columns");
+  kept = want + "\n";
   while (std::getline(in, line)) {
     if (line.empty()) continue;
     char* end = nullptr;
     const double step = std::strtod(line.c_str(), &end);
     const auto commas = static_cast<std::size_t>(std::count(line.begin(), line.end(), ','));
-    if (end == line.c_str() || *end != ',' || commas + 1 != columns_.size()) break;  // a torn last row
+    if (end == line.c_str() || *end != ',' || commas + 1 != had.size()) break;  // a torn last row
     if (step > static_cast<double>(keep_through_step)) break;
-    kept += line + "\n";
+    if (header == want) {
+      kept += line + "\n";
+      continue;
+    }
+    const std::vector<std::string> old = split_commas(line);
+    for (std::size_t i = 0; i < columns_.size(); ++i) kept += (i ? "," : "") + (from[i] >= 0 ? old[from[i]] : "nan");
+    kept += "\n";
   }
   in.close();
   write_file_atomically(path_, kept);

@@ -18,10 +18,13 @@ class DiagnosticsCsv {
   // in `columns`; std::runtime_error if the file cannot be written.
   DiagnosticsCsv(const std::string& path, std::vector<std::string> columns,
                  const std::set<std::string>& integer_columns = {});
-  // Restart: continues an existing file whose header must equal `columns`;
+  // Restart: continues an existing file whose header must equal `columns`,
+  // or list only columns that `columns` has (a file of an older version: its
+  // rows are rewritten in `columns`' order, "nan" in the added columns);
   // rows whose first column (the step) exceeds `keep_through_step` are dropped
   // first (the file is rewritten atomically), then rows are appended. Throws
-  // std::runtime_error naming the file when it is missing or its header differs.
+  // std::runtime_error naming the file when it is missing or its header has a
+  // column `columns` lacks.
   DiagnosticsCsv(const std::string& path, std::vector<std::string> columns,
                  const std::set<std::string>& integer_columns, long keep_through_step);
   ~DiagnosticsCsv();

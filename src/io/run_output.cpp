@@ -18,7 +18,7 @@ std::vector<std::string> diagnostics_columns(const std::vector<std::string>& bod
       "step_s", "active_grid_nodes", "contact_pairs", "min_distance", "barrier_energy", "friction_iters",
       "ccd_alpha_min", "contact_force_x", "contact_force_y", "contact_force_z", "contact_lo_x",
       "contact_lo_y", "contact_lo_z", "contact_hi_x", "contact_hi_y", "contact_hi_z", "penetrations",
-      "penetration_depth"};
+      "penetration_depth", "penetrations_fem", "penetrations_level_set"};
   for (const std::string& b : bodies)
     for (const char* f : body_column_fields()) cols.push_back(b + "." + f);
   return cols;
@@ -38,7 +38,8 @@ std::vector<double> diagnostics_row(const StepReport& r) {
           static_cast<double>(r.contact_pairs), r.min_distance, r.barrier_energy,
           static_cast<double>(r.friction_iters), r.ccd_alpha_min, r.contact_force[0], r.contact_force[1],
           r.contact_force[2], r.contact_lo[0], r.contact_lo[1], r.contact_lo[2], r.contact_hi[0],
-          r.contact_hi[1], r.contact_hi[2], static_cast<double>(r.penetrations), r.penetration_depth};
+          r.contact_hi[1], r.contact_hi[2], static_cast<double>(r.penetrations), r.penetration_depth,
+          static_cast<double>(r.penetrations_fem), static_cast<double>(r.penetrations_level_set)};
   for (const BodyReport& b : r.bodies) {
     const double v[] = {b.mass,        b.com[0],      b.com[1], b.com[2], b.velocity[0],
                         b.velocity[1], b.velocity[2], b.kinetic, b.elastic};
@@ -67,7 +68,8 @@ RunOutput<dim>::RunOutput(const std::string& dir, const Scene& scene, const Simu
                           const OutputResume* resume, MPI_Comm comm)
     : dir_(prepare_dir(dir)), root_(rank_of(comm) == 0), xdmf_(dir + "/bfemp.xdmf", "bfemp.h5") {
   const std::set<std::string> ints = {"step", "newton_iters", "linear_iters", "active_grid_nodes", "contact_pairs",
-                                      "friction_iters", "penetrations"};
+                                      "friction_iters", "penetrations", "penetrations_fem",
+                                      "penetrations_level_set"};
   const auto columns = diagnostics_columns(sim.body_names());
   if (resume) {
     h5_ = std::make_unique<Hdf5FrameWriter>(dir + "/bfemp.h5", resume->frames, comm);

@@ -601,6 +601,8 @@ void Simulation<dim>::count_penetrations(StepReport& r) {
     fem_count = sum[1];
   }
   r.penetrations = fem_count + ls_count;
+  r.penetrations_fem = fem_count;
+  r.penetrations_level_set = ls_count;
   r.penetration_depth = ls_count > 0 ? depth : 0.0;  // (the Max reducer starts at -DBL_MAX)
 }
 

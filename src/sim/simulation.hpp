@@ -67,8 +67,10 @@ struct StepReport {
   std::array<double, 3> contact_lo{0, 0, 0}, contact_hi{0, 0, 0};
   // With SimulationSetup::count_penetrations: particles inside an FEM element
   // or inside a level set's solid at the end of the step, and the deepest
-  // level-set penetration (m); -1 and NaN when not counted.
+  // level-set penetration (m); -1 and NaN when not counted. The count split:
+  // particles inside an FEM element, inside a level set's solid.
   long penetrations = -1;
+  long penetrations_fem = -1, penetrations_level_set = -1;
   double penetration_depth = std::numeric_limits<double>::quiet_NaN();
   double contact_broad_phase_s = 0, contact_eval_s = 0, contact_ccd_s = 0;
   double step_s = 0;

@@ -268,6 +268,8 @@ TEST(ContactSinePress, LevelSetSlipSinePenetratesAndAdheres) {
     max_depth[seg] = std::max(max_depth[seg], depth);
     // Output/count penetrations reports the same (no particle is in the ground).
     EXPECT_EQ(r.penetrations, inside) << "step " << r.step;
+    EXPECT_EQ(r.penetrations_level_set, inside) << "step " << r.step;
+    EXPECT_EQ(r.penetrations_fem, 0) << "step " << r.step;  // the level-set run has no FEM body
     EXPECT_NEAR(r.penetration_depth, depth, 1e-15) << "step " << r.step;
     if (seg == 2) {
       const double e = particle_kinetic(h) + r.elastic;

@@ -47,6 +47,35 @@ TEST(DiagnosticsCsv, HeaderAndRowsFlushed) {
   EXPECT_EQ(csv.columns().size(), 4u);
 }
 
+// Restart: the rows after the checkpoint's step go; a file of an older
+// version (fewer columns) is rewritten in the new columns with "nan" in the
+// added ones; a file with a column this version lacks is refused.
+TEST(DiagnosticsCsv, ResumeKeepsRowsThroughTheStepAndUpgradesOlderColumns) {
+  const std::string path = scratch("resume.csv");
+  {
+    std::ofstream f(path);
+    f << "step,time,count\n0,0,5\n1,0.5,6\n2,1,7\n3,1.5,8";  // a torn last row
+  }
+  {
+    DiagnosticsCsv csv(path, {"step", "time", "count"}, {"step", "count"}, 1);
+    csv.write_row({2, 1.25, 9});
+  }
+  EXPECT_EQ(slurp(path), "step,time,count\n0,0,5\n1,0.5,6\n2,1.25,9\n");
+  {
+    DiagnosticsCsv csv(path, {"step", "time", "added", "count"}, {"step", "count"}, 1);
+    csv.write_row({2, 1.25, 3, 9});
+  }
+  EXPECT_EQ(slurp(path), "step,time,added,count\n0,0,nan,5\n1,0.5,nan,6\n2,1.25,3,9\n");
+  try {
+    DiagnosticsCsv csv(path, {"step", "time", "count"}, {"step"}, 1);
+    ADD_FAILURE() << "a file with a column this version lacks was accepted";
+  } catch (const std::runtime_error& e) {
+    const std::string msg = e.what();
+    EXPECT_NE(msg.find("resume.csv"), std::string::npos) << msg;
+    EXPECT_NE(msg.find("added"), std::string::npos) << msg;
+  }
+}
+
 TEST(DiagnosticsCsv, IntegerColumnsOnlyWhenIntegral) {
   const std::string path = scratch("ints.csv");
   {
