@@ -316,6 +316,7 @@ RunSummary run_dim(const Scene& scene, const std::string& dir, const Teuchos::RC
   s.wall_s = wall.seconds();
   for (const auto& [name, sec] : sim.newton().term_assembly_seconds()) s.term_assembly_s.emplace_back(name, sec);
   s.graph_builds = sim.newton().dof_space().graph_builds();
+  s.graph_build_causes = sim.newton().dof_space().build_causes();
   s.exchange_s = sim.newton().dof_space().exchange_seconds();
   s.exchange_mb = 1e-6 * sim.newton().dof_space().exchange_bytes();
   s.graph_build_s = sim.newton().dof_space().graph_build_seconds();
@@ -400,7 +401,14 @@ RunSummary run_scene(const Scene& scene, const std::string& dir, const Teuchos::
     log << "    " << std::left << std::setw(18) << name << std::right << sec << " s ("
         << std::setprecision(3) << (s.assembly_s > 0 ? 100.0 * sec / s.assembly_s : 0.0) << " %)\n";
   log << "  graph builds        " << s.graph_builds << " (symbolic factorisations " << s.symbolic_factorizations
-      << "; " << s.graph_build_s << " s, within the step time)\n"
+      << "; " << s.graph_build_s << " s, within the step time)\n";
+  if (!s.graph_build_causes.empty()) {
+    log << "    built because     ";
+    for (std::size_t k = 0; k < s.graph_build_causes.size(); ++k)
+      log << (k ? ", " : "") << s.graph_build_causes[k].first << " " << s.graph_build_causes[k].second;
+    log << (s.mpm_ranks > 1 ? " (on rank 0)" : "") << "\n";
+  }
+  log
       << "  linear-solve time   " << s.solve_s << " s\n";
   if (s.numeric_factorizations > 0)
     log << "  factorisations      " << s.numeric_factorizations << " numeric, for " << s.newton_iterations

@@ -81,6 +81,20 @@ bool DofSpace<dim>::set_structure(LO n_nodes, const std::vector<const EnergyTerm
     throw std::invalid_argument("DofSpace::set_structure: " + std::to_string(n_nodes) +
                                 " nodes, but the partition has " + std::to_string(global_nodes_.size()));
   bool same = !A_.is_null() && !maps_stale_ && n_nodes == n_nodes_ && terms == terms_ && versions == versions_;
+  std::string cause = "another rank";  // what changed here, if anything
+  if (A_.is_null()) {
+    cause = "first";
+  } else if (maps_stale_ || n_nodes != n_nodes_) {
+    cause = "nodes";
+  } else if (terms != terms_) {
+    cause = "terms";
+  } else {
+    for (std::size_t k = 0; k < terms.size(); ++k)
+      if (versions[k] != versions_[k]) {
+        cause = terms[k]->name();
+        break;
+      }
+  }
   if (distributed()) {  // maps and graph are built collectively: every rank decides alike
     const int mine[2] = {same ? 0 : 1, maps_stale_ || map_.is_null() ? 1 : 0};
     int any[2] = {0, 0};
@@ -101,12 +115,23 @@ bool DofSpace<dim>::set_structure(LO n_nodes, const std::vector<const EnergyTerm
     map_ = Teuchos::rcp(new Map(static_cast<Tpetra::global_size_t>(n_nodes) * dim, 0, comm_));
     n_nodes_ = n_nodes;
   }
-  rebuild();
+  rebuild(cause);
   return true;
 }
 
 template <int dim>
-void DofSpace<dim>::rebuild() {
+void DofSpace<dim>::count_cause(const std::string& cause) {
+  for (auto& c : causes_)
+    if (c.first == cause) {
+      ++c.second;
+      return;
+    }
+  causes_.emplace_back(cause, 1);
+}
+
+template <int dim>
+void DofSpace<dim>::rebuild(const std::string& cause) {
+  count_cause(cause);
   Kokkos::Timer timer;
   std::vector<long long> keys;
   for (const auto* t : terms_) t->add_couplings(keys, n_nodes_);

@@ -31,6 +31,8 @@
 #include <Tpetra_Import_decl.hpp>
 #include <cstdint>
 #include <memory>
+#include <string>
+#include <utility>
 #include <vector>
 
 #include "solver/energy_term.hpp"
@@ -68,8 +70,8 @@ class DofSpace {
   // versions).
   bool set_structure(LO n_nodes, const std::vector<const EnergyTerm<dim>*>& terms);
   // Rebuilds the graph from the terms' couplings now (a term's update()
-  // found couplings the graph lacks).
-  void rebuild();
+  // found couplings the graph lacks), counted under `cause`.
+  void rebuild(const std::string& cause = "couplings found mid-solve");
 
   LO num_nodes() const { return n_nodes_; }
   std::size_t num_dofs() const { return static_cast<std::size_t>(n_nodes_ < 0 ? 0 : n_nodes_) * dim; }
@@ -108,6 +110,11 @@ class DofSpace {
   long missing_block_rebuilds() const { return missing_rebuilds_; }
   void count_missing_block_rebuild() { ++missing_rebuilds_; }
   long graph_reuses() const { return graph_reuses_; }
+  // Why the graph was built, with counts, in order of first occurrence:
+  // "first", "nodes" (the node set changed), a term's name (its couplings
+  // changed), "terms" (another term list), "another rank" (distributed: only
+  // elsewhere), or rebuild()'s cause.
+  const std::vector<std::pair<std::string, long>>& build_causes() const { return causes_; }
   double last_graph_build_s() const { return graph_build_s_; }
   // All graph builds since construction on this rank (graph, matrices, the
   // exchange plan between ranks, set_matrix).
@@ -143,6 +150,8 @@ class DofSpace {
   std::vector<std::uint64_t> versions_;
   SlipConstraints<dim> slip_;
   long graph_builds_ = 0, graph_reuses_ = 0, missing_rebuilds_ = 0;
+  std::vector<std::pair<std::string, long>> causes_;
+  void count_cause(const std::string& cause);
   Kokkos::View<int, MemSpace> dropped_;
   double graph_build_s_ = 0, graph_build_total_s_ = 0;
   double exchange_s_ = 0, exchange_bytes_ = 0;

@@ -304,7 +304,7 @@ NewtonStats NewtonSolver<dim>::minimize(const IncrementalPotential& ip, View1 x)
     for (const auto* t : m.dofs.terms()) grow = t->update(x) || grow;
     grow = m.all_max(grow ? 1.0 : 0.0) > 0;
     if (grow) {
-      m.dofs.rebuild();
+      m.dofs.rebuild("pairs found mid-solve");
       m.matrix_changed();
       m.refresh_modes(x);
       ++st.graph_builds;
@@ -313,7 +313,7 @@ NewtonStats NewtonSolver<dim>::minimize(const IncrementalPotential& ip, View1 x)
     m.assemble(ip, x, project);
     if (m.dofs.dropped_blocks() > 0) {
       // A term's couplings were not in the cached graph: never drop them.
-      m.dofs.rebuild();
+      m.dofs.rebuild("blocks missing from the graph");
       m.matrix_changed();
       m.refresh_modes(x);
       m.dofs.count_missing_block_rebuild();

@@ -269,6 +269,10 @@ TEST(DofSpace, UnchangedStructureBuildsTheGraphOnce) {
   EXPECT_EQ(sim.newton().dof_space().graph_builds(), 1);
   EXPECT_EQ(sim.newton().dof_space().graph_reuses(), 4);
   EXPECT_EQ(symbolic, 1);
+  const auto& why = sim.newton().dof_space().build_causes();
+  ASSERT_EQ(why.size(), 1u);
+  EXPECT_EQ(why[0].first, "first");
+  EXPECT_EQ(why[0].second, 1);
 }
 
 // A block thrown across cells: the graph is rebuilt when, and only when, the
@@ -287,6 +291,15 @@ TEST(DofSpace, MovingBlockRebuildsOnlyWhenCellsChange) {
   EXPECT_EQ(total, builds);
   EXPECT_GE(total, 2);
   EXPECT_LT(total, steps / 2);
+  // Every build has its cause: the first, then the node set or the cells.
+  long counted = 0;
+  for (const auto& [cause, n] : sim.newton().dof_space().build_causes()) {
+    counted += n;
+    EXPECT_TRUE(cause == "first" || cause == "nodes" || cause == sim.newton().dof_space().terms().back()->name())
+        << cause;
+  }
+  EXPECT_EQ(counted, total);
+  EXPECT_EQ(sim.newton().dof_space().build_causes().front().first, "first");
   std::cout << "  graph builds: " << total << " in " << steps << " steps\n";
 }
 
