@@ -78,6 +78,23 @@
 // with |v|max ~50 m/s; single-material XPIC(5) reaches 20 % at dt 0.5, 0.7 and
 // 0.9. Error of LR + XPIC(5) against single-material XPIC(5) at 1/2/3/4/5 %
 // strain: -0.57/-0.28/-0.19/-0.15/-0.15 % (before: -0.31/-0.19/-0.13/-0.11/-0.17 %).
+// Reviewed against the paper (2026-12-04, night): the multimaterial XPIC
+// (Eqs. 37-44: v*^alpha from the pass-1 velocity and Delta v^alpha, mass
+// weights m_i^alpha, signs and factors) and the step order (Eqs. 26-34)
+// match. Checks with USAVG: XPIC(1) = PIC (0.000 %); stick law, XPIC(5)
+// against single-material XPIC(5): 0.002 % (USF 0.019 %), the small Eq. 47
+// difference; Coulomb: FLIP / XPIC(2) / XPIC(5) / uncorrected XPIC(5)
+// 0.78 / 1.26 / 1.09 / 1.15 %, one shared error curve that jumps from ~0.3 %
+// to ~1 % between 11 and 12 % strain as the interface crosses y = 45 mm,
+// so the Delta v term is not the cause. Frames: the interior interface
+// slips < 6 um; the block-edge columns overlap vertically by 51 / 441 /
+// 723 um at 5.6 / 12.4 / 20 % strain (the corner sinking above). USF + PIC,
+// XPIC(2), uncorrected or frictionless XPIC all stop at 5.9-6.2 %: a
+// particle kicked to 22-29 m/s when the interface is mid-cell (d_LR ~ 0).
+// Tried and not kept: the 1e-3 penalty only for clouds whose per-axis
+// variance is below 1e-4 dx^2 (the edge columns): USAVG LR 0.761 %, LR once
+// 0.168 % (better than two passes, against the paper's finding), LR + XPIC(5)
+// 1.03 % (one spike): the corners improve, the spikes set the maximum.
 // Mechanism at dt 0.9 (per-node d_LR prints): for
 // touching blocks d_LR = gap - R_a - R_b is zero up to round-off (the inscribed
 // ellipses of Eq. 25 tile the interface), so every interface node sits on the
