@@ -69,34 +69,52 @@ void BarrierTerm<dim>::begin_step(const ParticleStencils<dim>& ps, ConstDofView 
   // Signature of the couplings: each pair with its particle's stencil base
   // node (the stencil's other nodes follow from it while the MPM cells are
   // unchanged; when they change, the MPM term's version forces a rebuild).
+  // The broad phase returns the pairs sorted by (particle, facet), so two
+  // signatures are equal iff they are equal entry by entry: compared on the
+  // device, no host copy unless the graph must change.
   if (static_cast<LO>(signature_dev_.extent(0)) < n_pairs_)  // grows, not per step
     signature_dev_ = Kokkos::View<long long* [2], MemSpace>("contact_graph_signature", n_pairs_ + n_pairs_ / 4 + 16);
   const auto sig_dev = signature_dev_;
-  {
-    const auto pairs = pairs_;
-    const auto nodes = ps.nodes;
-    const long long np = prims_.size();
-    Kokkos::parallel_for(
-        "contact_graph_signature", Kokkos::RangePolicy<ExecSpace>(0, n_pairs_), KOKKOS_LAMBDA(const LO k) {
-          sig_dev(k, 0) = pairs(k, 0) * np + pairs(k, 1);
-          sig_dev(k, 1) = nodes(pairs(k, 0), 0);
-        });
-  }
-  auto sig_h = Kokkos::create_mirror_view_and_copy(
-      Kokkos::HostSpace(), Kokkos::subview(sig_dev, std::make_pair(LO(0), n_pairs_), Kokkos::ALL()));
-  std::vector<std::pair<long long, long long>> sig(n_pairs_);
-  for (LO k = 0; k < n_pairs_; ++k) sig[k] = {sig_h(k, 0), sig_h(k, 1)};
-  std::sort(sig.begin(), sig.end());
+  const auto pairs = pairs_;
+  const auto nodes = ps.nodes;
+  const long long np = prims_.size();
+  Kokkos::parallel_for(
+      "contact_graph_signature", Kokkos::RangePolicy<ExecSpace>(0, n_pairs_), KOKKOS_LAMBDA(const LO k) {
+        sig_dev(k, 0) = pairs(k, 0) * np + pairs(k, 1);
+        sig_dev(k, 1) = nodes(pairs(k, 0), 0);
+      });
   // The graph holds exactly these pairs with these stencils only if the last
   // step did not grow it (grown pairs were recorded with that step's stencils).
-  if (sig == signature_ && !grown_) return;
+  if (n_pairs_ == n_signature_ && !grown_) {
+    const auto prev = graph_signature_;
+    LO differ = 0;
+    Kokkos::parallel_reduce(
+        "contact_graph_signature_compare", Kokkos::RangePolicy<ExecSpace>(0, n_pairs_),
+        KOKKOS_LAMBDA(const LO k, LO& acc) {
+          if (sig_dev(k, 0) != prev(k, 0) || sig_dev(k, 1) != prev(k, 1)) ++acc;
+        },
+        differ);
+    if (differ == 0) return;
+  }
   grown_ = false;
-  signature_ = std::move(sig);
+  if (static_cast<LO>(graph_signature_.extent(0)) < n_pairs_)
+    graph_signature_ = Kokkos::View<long long* [2], MemSpace>("contact_graph_signature_kept", signature_dev_.extent(0));
+  const auto kept = graph_signature_;
+  Kokkos::parallel_for(
+      "contact_graph_signature_keep", Kokkos::RangePolicy<ExecSpace>(0, n_pairs_), KOKKOS_LAMBDA(const LO k) {
+        kept(k, 0) = sig_dev(k, 0);
+        kept(k, 1) = sig_dev(k, 1);
+      });
+  n_signature_ = n_pairs_;
   ++version_;
-  graph_keys_.clear();
-  for (const auto& e : signature_) graph_keys_.push_back(e.first);
-  graph_keys_dev_ = Kokkos::View<long long*, MemSpace>("contact_graph_keys", graph_keys_.size());
-  Kokkos::deep_copy(graph_keys_dev_, Kokkos::View<const long long*, Kokkos::HostSpace>(graph_keys_.data(), graph_keys_.size()));
+  // The graph changes: the keys for add_couplings (host) and update() (device).
+  graph_keys_dev_ = Kokkos::View<long long*, MemSpace>("contact_graph_keys", static_cast<std::size_t>(n_pairs_));
+  const auto keys = graph_keys_dev_;
+  Kokkos::parallel_for(
+      "contact_graph_keys", Kokkos::RangePolicy<ExecSpace>(0, n_pairs_),
+      KOKKOS_LAMBDA(const LO k) { keys(k) = sig_dev(k, 0); });
+  auto hk = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), keys);
+  graph_keys_.assign(hk.data(), hk.data() + hk.extent(0));
 }
 
 template <int dim>

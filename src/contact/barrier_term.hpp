@@ -83,8 +83,10 @@ class BarrierTerm : public EnergyTerm<dim> {
   mutable LO n_pairs_ = 0;
   mutable std::vector<long long> graph_keys_;  // q * n_prims + j, sorted
   mutable Kokkos::View<long long*, MemSpace> graph_keys_dev_;
-  std::vector<std::pair<long long, long long>> signature_;  // (pair key, stencil base) at begin_step
-  Kokkos::View<long long* [2], MemSpace> signature_dev_;
+  // (pair key, stencil base) of each begin_step pair, in the broad phase's
+  // (sorted) order: this step's, and those the graph was last asked for.
+  Kokkos::View<long long* [2], MemSpace> signature_dev_, graph_signature_;
+  LO n_signature_ = 0;
   mutable Kokkos::View<double*, MemSpace> pair_distance_;
   mutable std::uint64_t version_ = 0;
   mutable bool grown_ = false;  // update() added pairs in this step
