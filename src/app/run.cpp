@@ -152,6 +152,7 @@ void accumulate(RunSummary& s, const StepReport& r) {
   s.contact_ccd_s += r.contact_ccd_s;
   s.symbolic_factorizations += r.newton.symbolic_factorizations;
   s.numeric_factorizations += r.newton.numeric_factorizations;
+  s.stale_retries += r.newton.stale_retries;
   s.projected_retries += r.newton.projected_retries;
   s.exact_hessian_iterations += r.newton.exact_hessian_iterations;
   s.projection_fallbacks += r.newton.projection_fallbacks;
@@ -412,7 +413,9 @@ RunSummary run_scene(const Scene& scene, const std::string& dir, const Teuchos::
       << "  linear-solve time   " << s.solve_s << " s\n";
   if (s.numeric_factorizations > 0)
     log << "  factorisations      " << s.numeric_factorizations << " numeric, for " << s.newton_iterations
-        << " Newton iterations (the others: CG on the previous factor)\n";
+        << " Newton iterations (the others: CG on the previous factor)"
+        << (s.stale_retries > 0 ? "; " + std::to_string(s.stale_retries) + " solve(s) redone on a fresh factor" : std::string())
+        << "\n";
   if (s.exact_hessian_iterations + s.projection_fallbacks > 0)
     log << "  exact Hessian       " << s.exact_hessian_iterations << " of " << s.newton_iterations
         << " iterations (" << s.projection_fallbacks << " not positive definite: projected";

@@ -32,6 +32,7 @@ struct RunSummary {
   double exchange_mb = 0;  // MB the busiest rank sent in the DOF exchanges
   double graph_build_s = 0;  // DofSpace graph builds (the slowest rank)
   long graph_builds = 0, symbolic_factorizations = 0, numeric_factorizations = 0;
+  long stale_retries = 0;  // CG + BLOCK_CHOLMOD solves redone after the kept factor failed
   std::vector<std::pair<std::string, long>> graph_build_causes;  // DofSpace::build_causes (rank 0's)
   long projected_retries = 0;  // steps redone with the projected Hessian
   long exact_hessian_iterations = 0, projection_fallbacks = 0;  // Newton/hessian: exact-if-definite

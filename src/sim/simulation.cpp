@@ -634,6 +634,7 @@ NewtonStats Simulation<dim>::minimize_with_friction(const IncrementalPotential& 
     total.graph_builds += st.graph_builds;
     total.symbolic_factorizations += st.symbolic_factorizations;
     total.numeric_factorizations += st.numeric_factorizations;
+    total.stale_retries += st.stale_retries;
     total.exact_hessian_iterations += st.exact_hessian_iterations;
     total.projection_fallbacks += st.projection_fallbacks;
     total.partial_projections += st.partial_projections;

@@ -376,6 +376,7 @@ NewtonStats NewtonSolver<dim>::minimize(const IncrementalPotential& ip, View1 x)
     st.linear_iterations += ls.iterations;
     if (ls.refactored) ++st.symbolic_factorizations;
     if (ls.factorised) ++st.numeric_factorizations;
+    st.stale_retries += ls.stale_retries;
     m.dofs.to_local(*m.p, dir);
     st.solve_s += timer.seconds();
 
