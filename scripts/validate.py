@@ -83,22 +83,32 @@ def scenes(size):
              lambda v: v == 0, "0"),
             ("A2_bfemp", "contact force on the boundary, min y (N/m; < 0 = adhesion)",
              "min:column=contact_force_y", ">= 0", lambda v: v >= 0, ">= 0"),
+            # The level-set counts include the no-slip ground (a level set in
+            # both runs): each level-set band must beat what the BFEMP run's
+            # ground alone shows, measured by the row before it.
+            ("A2_bfemp", "particles inside the ground level set (max over steps)",
+             "max:column=penetrations_level_set", "(the ground alone)", None, "reported"),
             ("A2_levelset", "particles inside the level-set solids (max over steps)",
-             "max:column=penetrations_level_set",
-             "> 0 (measurable)", lambda v: v > 0, "> 0"),
-            ("A2_levelset", "deepest level-set penetration (m)", "max:column=penetration_depth", "> 0",
-             lambda v: v > 0, "> 0"),
+             "max:column=penetrations_level_set", "> the ground's (measurable)",
+             lambda v, on: v > on.get("A2_bfemp", float("inf")), "> the BFEMP run's ground count"),
+            ("A2_bfemp", "deepest ground level-set penetration (m)", "max:column=penetration_depth",
+             "(the ground alone)", None, "reported"),
+            ("A2_levelset", "deepest level-set penetration (m)", "max:column=penetration_depth",
+             "> the ground's", lambda v, on: v > on.get("A2_bfemp", float("inf")), "> the BFEMP run's ground depth"),
             # Adhesion: the troughs have risen above the box's rest top (by
             # 5 cm at the paper size from t = 1.55 s, 5 mm at the ci size from
             # 0.125 s), so a particle still inside the solid is held up by it.
+            ("A2_bfemp", "particles inside the ground level set (max over t >= %s s)" % a2_lifted,
+             "max:column=penetrations_level_set,from=%s" % a2_lifted, "(the ground alone)", None, "reported"),
             ("A2_levelset", "particles held inside the lifted boundary (adhesion; max over t >= %s s)" % a2_lifted,
-             "max:column=penetrations_level_set,from=%s" % a2_lifted, "> 0 (adhesion)", lambda v: v > 0, "> 0"),
+             "max:column=penetrations_level_set,from=%s" % a2_lifted, "> the ground's (adhesion)",
+             lambda v, on: v > on.get("A2_bfemp", float("inf")), "> the BFEMP run's ground count"),
             ("A2_bfemp", "contact pairs with the lifted boundary (max over t >= %s s)" % a2_lifted,
              "max:column=contact_pairs,from=%s" % a2_lifted, "0 (no adhesion)", lambda v: v == 0, "0"),
         ],
         "plot": plot_a2,
-        "notes": {"paper": ["22500 particles (9 per cell) against the paper's 21026 (a 145 x 145 lattice, which "
-                            "per-cell sampling cannot give)",
+        "notes": {"paper": ["22500 particles (9 per cell) against the paper's 21026 (about a 145 x 145 lattice, "
+                            "21025, which per-cell sampling cannot give)",
                             "the BFEMP run's no-slip ground is a level set on the grid: under the 40 % compression "
                             "it lets up to 5 particles 0.68 mm into it (diagnostics.csv penetrations_level_set); "
                             "the FEM boundary lets none in"]},

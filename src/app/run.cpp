@@ -318,6 +318,7 @@ RunSummary run_dim(const Scene& scene, const std::string& dir, const Teuchos::RC
   for (const auto& [name, sec] : sim.newton().term_assembly_seconds()) s.term_assembly_s.emplace_back(name, sec);
   s.graph_builds = sim.newton().dof_space().graph_builds();
   s.graph_build_causes = sim.newton().dof_space().build_causes();
+  s.ranks = comm->getSize();
   s.exchange_s = sim.newton().dof_space().exchange_seconds();
   s.exchange_mb = 1e-6 * sim.newton().dof_space().exchange_bytes();
   s.graph_build_s = sim.newton().dof_space().graph_build_seconds();
@@ -407,7 +408,7 @@ RunSummary run_scene(const Scene& scene, const std::string& dir, const Teuchos::
     log << "    built because     ";
     for (std::size_t k = 0; k < s.graph_build_causes.size(); ++k)
       log << (k ? ", " : "") << s.graph_build_causes[k].first << " " << s.graph_build_causes[k].second;
-    log << (s.mpm_ranks > 1 ? " (on rank 0)" : "") << "\n";
+    log << (s.ranks > 1 ? " (on rank 0)" : "") << "\n";
   }
   log
       << "  linear-solve time   " << s.solve_s << " s\n";

@@ -42,6 +42,7 @@ struct RunSummary {
   // MPI, MPM bodies in slabs: ranks, particle migrations, slab rebalances and
   // the particle imbalance (largest / mean per rank) at the end.
   int mpm_ranks = 1, rebalances = 0;
+  int ranks = 1;  // MPI ranks of the run
   long long migrations = 0;
   double imbalance = 1.0;
 };

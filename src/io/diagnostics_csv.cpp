@@ -57,9 +57,13 @@ DiagnosticsCsv::DiagnosticsCsv(const std::string& path, std::vector<std::string>
     if (it != had.end()) from[i] = it - had.begin();
   }
   const auto found = static_cast<std::size_t>(std::count_if(from.begin(), from.end(), [](long f) { return f >= 0; }));
-  if (header != want && found != had.size())
-    throw std::runtime_error(where + "header '" + header + "' differs from this version's columns ('" + want +
-                             "') by more than added columns");
+  if (header != want && found != had.size()) {
+    std::string extra;
+    for (const std::string& c : had)
+      if (std::find(columns_.begin(), columns_.end(), c) == columns_.end()) extra += (extra.empty() ? "'" : ", '") + c + "'";
+    throw std::runtime_error(where + "its column(s) " + extra + " are not in this version's columns ('" + want +
+                             "'): it cannot be continued");
+  }
   kept = want + "\n";
   while (std::getline(in, line)) {
     if (line.empty()) continue;

@@ -197,6 +197,7 @@ struct LinearSolver::Impl {
   // every time.
   bool block_reuse = true;
   bool block_valid = false;
+  bool block_retrying = false;  // solve() is redoing a stale-factor failure on a fresh factor
   double block_fact_its = 0, block_fresh_rate = 0, block_excess_its = 0;
   CholmodDirect::Reuse reuse;
   RCP<Vector> residual;  // direct solves: the residual check, kept across solves
@@ -450,7 +451,7 @@ LinearSolveStats LinearSolver::solve(const Vector& b, Vector& x, double forcing)
   }
   stats.iterations = cg.getNumIters();
   stats.achieved_tol = cg.achievedTol();
-  if (!m.block.is_null() && m.block_reuse && ret == Belos::Converged && stats.iterations > 0) {
+  if (!m.block.is_null() && m.block_reuse && ret == Belos::Converged && stats.iterations > 0 && !m.block_retrying) {
     // CG iterations per decade of residual reduction, fresh factor against stale
     const double decades = std::max(1.0, -std::log10(std::max(stats.achieved_tol, 1e-300)));
     const double rate = stats.iterations / decades;
@@ -460,8 +461,17 @@ LinearSolveStats LinearSolver::solve(const Vector& b, Vector& x, double forcing)
   if (ret != Belos::Converged && !m.block.is_null() && !stats.factorised) {
     // The stale factor was not good enough for these values: refactorise and
     // solve again from CG's last iterate (a failure then is the solver's).
+    // (Its rate, from CG's last iterate, is not a fresh factor's rate from zero.)
     m.block_valid = false;
-    LinearSolveStats again = solve(b, x, forcing);
+    m.block_retrying = true;
+    LinearSolveStats again;
+    try {
+      again = solve(b, x, forcing);
+    } catch (...) {
+      m.block_retrying = false;
+      throw;
+    }
+    m.block_retrying = false;
     again.iterations += stats.iterations;
     again.stale_retries += 1;
     return again;

@@ -72,7 +72,7 @@ TEST(DiagnosticsCsv, ResumeKeepsRowsThroughTheStepAndUpgradesOlderColumns) {
   } catch (const std::runtime_error& e) {
     const std::string msg = e.what();
     EXPECT_NE(msg.find("resume.csv"), std::string::npos) << msg;
-    EXPECT_NE(msg.find("added"), std::string::npos) << msg;
+    EXPECT_NE(msg.find("column(s) 'added'"), std::string::npos) << msg;
   }
 }
 
