@@ -288,4 +288,32 @@ TYPED_TEST(BSpline, IdentitiesHoldInsideKernels) {
   EXPECT_LT(err, 1e-12);
 }
 
+// for_each_stencil_node (the transfers' one-pass visit) gives, node by node
+// and in stencil order, the same node, weight, gradient and x_i - x_p as
+// node_index, weight, weight_gradient and node_position.
+TYPED_TEST(BSpline, ForEachStencilNodeMatchesTheIndexedQueries) {
+  constexpr int dim = TypeParam::value;
+  std::mt19937 rng(7);
+  for (bool binary : {false, true}) {
+    const auto g = test_grid<dim>(binary);
+    for (const auto& x : test_positions<dim>(g, rng)) {
+      const auto st = bspline_stencil<dim>(g, x);
+      int visited = 0;
+      for_each_stencil_node<dim>(g, st, x, [&](int a, LO node, double w, const Vec<dim>& gw, const Vec<dim>& r) {
+        EXPECT_EQ(a, visited);
+        ++visited;
+        EXPECT_EQ(node, node_index<dim>(g, st, a));
+        EXPECT_NEAR(w, weight<dim>(st, a), 1e-15);
+        const Vec<dim> ge = weight_gradient<dim>(st, a);
+        const Vec<dim> re = g.node_position(node) - x;
+        for (int d = 0; d < dim; ++d) {
+          EXPECT_NEAR(gw[d], ge[d], 1e-12 * (1.0 + std::fabs(ge[d])));
+          EXPECT_NEAR(r[d], re[d], 1e-14);
+        }
+      });
+      EXPECT_EQ(visited, bspline_stencil_size<dim>);
+    }
+  }
+}
+
 }  // namespace
