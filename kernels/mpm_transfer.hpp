@@ -67,8 +67,19 @@ LO activate_grid(const GridSpec<dim>& grid, const Particles<dim>& p, LO first,
   return count;
 }
 
+// Scatter target of P2G: one private copy of the grid arrays per thread
+// (reset before P2G, summed into the target by contribute after it), so the
+// adds are plain stores, and the sum order is fixed for a given thread count.
+// Atomic adds cost twice as much per particle, also on one thread
+// (perf/README.md, "P2G and G2P per particle").
+using GridScatter = Kokkos::Experimental::ScatterView<double*, Kokkos::LayoutRight, ExecSpace,
+                                                      Kokkos::Experimental::ScatterSum,
+                                                      Kokkos::Experimental::ScatterDuplicated,
+                                                      Kokkos::Experimental::ScatterNonAtomic>;
+
 // P2G: node mass and momentum (m v) of active node k = system id - first via
-// ScatterViews (persistent, created by the caller on the target views).
+// ScatterViews (persistent, created by the caller on the target views; a
+// GridScatter must be reset before and contributed after).
 template <int dim, class MassScatter, class MomentumScatter>
 void p2g(const GridSpec<dim>& grid, const Particles<dim>& p, TransferScheme scheme,
          Kokkos::View<const LO*, MemSpace> system_node, LO first, MassScatter mass, MomentumScatter momentum) {

@@ -62,16 +62,15 @@ std::string bench(std::size_t target, double bw) {
   Kokkos::View<LO*, MemSpace> system_node("sn", grid.num_nodes()), grid_node;
   const LO n_active = activate_grid<dim>(grid, p, 0, system_node, grid_node);
   Kokkos::View<double*, MemSpace> mass("m", n_active), mom("mv", n_active * dim);
-  auto ms = Kokkos::Experimental::create_scatter_view<Kokkos::Experimental::ScatterSum,
-                                                      Kokkos::Experimental::ScatterNonDuplicated,
-                                                      Kokkos::Experimental::ScatterAtomic>(mass);
-  auto vs = Kokkos::Experimental::create_scatter_view<Kokkos::Experimental::ScatterSum,
-                                                      Kokkos::Experimental::ScatterNonDuplicated,
-                                                      Kokkos::Experimental::ScatterAtomic>(mom);
+  GridScatter ms(mass), vs(mom);  // the production path's scatter (MpmBodies::begin_step)
   const double t_p2g = best_time([&] {
     Kokkos::deep_copy(mass, 0.0);
     Kokkos::deep_copy(mom, 0.0);
+    ms.reset();
+    vs.reset();
     p2g(grid, p, TransferScheme::APIC, system_node, 0, ms, vs);
+    Kokkos::Experimental::contribute(mass, ms);
+    Kokkos::Experimental::contribute(mom, vs);
   });
   Kokkos::View<double*, MemSpace> x("x", n_active * dim), v("v", n_active * dim), v0("v0", n_active * dim);
   Kokkos::parallel_for(

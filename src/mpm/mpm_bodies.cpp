@@ -311,13 +311,15 @@ LO MpmBodies<dim>::begin_step(LO first, long step) {
     const std::size_t cap = static_cast<std::size_t>(active_) * 5 / 4 + 16;  // grow, not per step
     mass_ = Kokkos::View<double*, MemSpace>("mpm_grid_mass", cap);
     momentum_ = Kokkos::View<double*, MemSpace>("mpm_grid_momentum", cap * dim);
-    mass_scatter_ = Scatter(mass_);
-    momentum_scatter_ = Scatter(momentum_);
+    mass_scatter_ = GridScatter(mass_);
+    momentum_scatter_ = GridScatter(momentum_);
   }
   Kokkos::deep_copy(Kokkos::subview(mass_, std::make_pair(0, active_)), 0.0);
   Kokkos::deep_copy(Kokkos::subview(momentum_, std::make_pair(0, active_ * dim)), 0.0);
+  mass_scatter_.reset();
+  momentum_scatter_.reset();
   p2g(grid, p, setup_.scheme, system_node_, first, mass_scatter_, momentum_scatter_);
-  Kokkos::Experimental::contribute(mass_, mass_scatter_);  // no-op for atomic, kept for portability
+  Kokkos::Experimental::contribute(mass_, mass_scatter_);  // the per-thread copies into mass_
   Kokkos::Experimental::contribute(momentum_, momentum_scatter_);
   if (distributed_) sum_shared_nodes();
   mpm_stencils(grid, p, system_node_, stencils_);

@@ -159,11 +159,7 @@ class MpmBodies {
   Kokkos::View<LO*, MemSpace> system_node_;  // per grid node
   Kokkos::View<LO*, MemSpace> grid_node_;    // per active node
   Kokkos::View<double*, MemSpace> mass_, momentum_;  // per active node (capacity grows)
-  using Scatter = Kokkos::Experimental::ScatterView<double*, Kokkos::LayoutRight, ExecSpace,
-                                                    Kokkos::Experimental::ScatterSum,
-                                                    Kokkos::Experimental::ScatterNonDuplicated,
-                                                    Kokkos::Experimental::ScatterAtomic>;
-  Scatter mass_scatter_, momentum_scatter_;
+  GridScatter mass_scatter_, momentum_scatter_;
   DeformationStencils<dim, ns> stencils_;
   ParticleCells<dim> cells_;
   std::unique_ptr<MpmElasticityTerm<dim>> term_;
