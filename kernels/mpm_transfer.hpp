@@ -138,10 +138,11 @@ void mpm_stencils(const GridSpec<dim>& grid, const Particles<dim>& p, Kokkos::Vi
 // G2P (Tables 1-3): x_p = sum w x~_i, v_p (PIC/APIC: sum w v~_i; FLIP: v_p +
 // sum w (v~_i - v_i^n)), F_p = sum x~_i grad w^T F_p^n, APIC B_p (Table 1)
 // stored as C_p = B_p D_p^-1 with D_p = dx^2/4 I.
-template <int dim>
-void g2p(const GridSpec<dim>& grid, const Particles<dim>& p, TransferScheme scheme,
-         Kokkos::View<const LO*, MemSpace> system_node, Kokkos::View<const double*, MemSpace> x_new,
-         Kokkos::View<const double*, MemSpace> v_new, Kokkos::View<const double*, MemSpace> v_old) {
+namespace detail {
+template <int dim, TransferScheme scheme>  // the scheme a compile-time constant: no branch per node
+void g2p(const GridSpec<dim>& grid, const Particles<dim>& p, Kokkos::View<const LO*, MemSpace> system_node,
+         Kokkos::View<const double*, MemSpace> x_new, Kokkos::View<const double*, MemSpace> v_new,
+         Kokkos::View<const double*, MemSpace> v_old) {
   const double inv_D = 4.0 / (grid.dx * grid.dx);
   Kokkos::parallel_for(
       "mpm_g2p", Kokkos::RangePolicy<ExecSpace>(0, p.size()), KOKKOS_LAMBDA(const LO q) {
@@ -150,33 +151,54 @@ void g2p(const GridSpec<dim>& grid, const Particles<dim>& p, TransferScheme sche
         Vec<dim> xn = Vec<dim>::Zero(), vn = Vec<dim>::Zero(), dv = Vec<dim>::Zero();
         Mat<dim> G = Mat<dim>::Zero();  // sum x~_i grad w^T
         // APIC (Table 1): B = 1/2 sum w [v_i (x_i - x_p + x~_i - x~_p)^T + (x_i - x_p - x~_i + x~_p) v_i^T]
-        // with x~_p = sum w x~_i = xn; the xn terms summed separately (sum w v_i = vn):
-        // B = 1/2 (S1 - vn xn^T + S2 + xn vn^T), S1 = sum w v_i (x_i - x_p + x~_i)^T,
-        // S2 = sum w (x_i - x_p - x~_i) v_i^T. One pass over the stencil.
-        Mat<dim> S = Mat<dim>::Zero();
-        const bool apic = scheme == TransferScheme::APIC, flip = scheme == TransferScheme::FLIP;
+        // with x~_p = sum w x~_i = xn and sum w v_i = vn. With u_i = w v_i and
+        // r_i = x_i - x_p: B = 1/2 (M + M^T + K - vn xn^T + xn vn^T), where
+        // M = sum u_i r_i^T and K = sum (u_i x~_i^T - x~_i u_i^T) is
+        // antisymmetric: K_jk = eps_jkl k_l with k = sum u_i x x~_i (3D), or
+        // K = [0 k; -k 0] with k = sum (u_0 x~_1 - u_1 x~_0) (2D). One pass;
+        // per node B costs dim^2 products for M and 6 (3D) / 2 (2D) for k, where
+        // the two sums S1, S2 of Table 1 cost 2 dim^2 (+ 2 dim).
+        Mat<dim> M = Mat<dim>::Zero();
+        constexpr int nk = dim == 3 ? 3 : 1;
+        double k[nk] = {};
+        constexpr bool apic = scheme == TransferScheme::APIC, flip = scheme == TransferScheme::FLIP;
         for_each_stencil_node<dim>(grid, st, xp, [&](int, LO gnode, double w, const Vec<dim>& gw, const Vec<dim>& r) {
-          const LO k = system_node(gnode);
-          Vec<dim> xt, vi;
+          const LO n = system_node(gnode);
+          Vec<dim> xt, u;
           for (int c = 0; c < dim; ++c) {
-            xt(c) = x_new(k * dim + c);
-            vi(c) = v_new(k * dim + c);
-            if (flip) dv(c) += w * (vi(c) - v_old(k * dim + c));  // v^n is read only by FLIP
+            xt(c) = x_new(n * dim + c);
+            const double vi = v_new(n * dim + c);
+            u(c) = w * vi;
+            if constexpr (flip) dv(c) += w * (vi - v_old(n * dim + c));  // v^n is read only by FLIP
           }
           for (int i = 0; i < dim; ++i) {
             xn(i) += w * xt(i);
-            vn(i) += w * vi(i);
-            const double wv = w * vi(i), wd = w * (r(i) - xt(i));
+            vn(i) += u(i);
             for (int j = 0; j < dim; ++j) {
               G(i, j) += xt(i) * gw(j);
-              if (apic) S(i, j) += wv * (r(j) + xt(j)) + wd * vi(j);
+              if constexpr (apic) M(i, j) += u(i) * r(j);
+            }
+          }
+          if constexpr (apic) {
+            if constexpr (dim == 3) {
+              k[0] += u(1) * xt(2) - u(2) * xt(1);
+              k[1] += u(2) * xt(0) - u(0) * xt(2);
+              k[2] += u(0) * xt(1) - u(1) * xt(0);
+            } else {
+              k[0] += u(0) * xt(1) - u(1) * xt(0);
             }
           }
         });
-        if (apic) {
-          const Mat<dim> B = 0.5 * (S - vn * xn.transpose() + xn * vn.transpose());
+        if constexpr (apic) {
+          Mat<dim> K;
+          if constexpr (dim == 3) {
+            K << 0, k[2], -k[1], -k[2], 0, k[0], k[1], -k[0], 0;
+          } else {
+            K << 0, k[0], -k[0], 0;
+          }
           for (int i = 0; i < dim; ++i)
-            for (int j = 0; j < dim; ++j) p.C(q, i, j) = B(i, j) * inv_D;
+            for (int j = 0; j < dim; ++j)
+              p.C(q, i, j) = 0.5 * (M(i, j) + M(j, i) + K(i, j) - vn(i) * xn(j) + xn(i) * vn(j)) * inv_D;
         }
         Mat<dim> Fn;
         for (int i = 0; i < dim; ++i)
@@ -185,10 +207,25 @@ void g2p(const GridSpec<dim>& grid, const Particles<dim>& p, TransferScheme sche
         for (int i = 0; i < dim; ++i)
           for (int j = 0; j < dim; ++j) p.F(q, i, j) = F1(i, j);
         for (int c = 0; c < dim; ++c) {
-          p.v(q, c) = scheme == TransferScheme::FLIP ? p.v(q, c) + dv(c) : vn(c);
+          p.v(q, c) = flip ? p.v(q, c) + dv(c) : vn(c);
           p.x(q, c) = xn(c);
         }
       });
+}
+}  // namespace detail
+
+template <int dim>
+void g2p(const GridSpec<dim>& grid, const Particles<dim>& p, TransferScheme scheme,
+         Kokkos::View<const LO*, MemSpace> system_node, Kokkos::View<const double*, MemSpace> x_new,
+         Kokkos::View<const double*, MemSpace> v_new, Kokkos::View<const double*, MemSpace> v_old) {
+  switch (scheme) {
+    case TransferScheme::APIC:
+      return detail::g2p<dim, TransferScheme::APIC>(grid, p, system_node, x_new, v_new, v_old);
+    case TransferScheme::FLIP:
+      return detail::g2p<dim, TransferScheme::FLIP>(grid, p, system_node, x_new, v_new, v_old);
+    case TransferScheme::PIC:
+      return detail::g2p<dim, TransferScheme::PIC>(grid, p, system_node, x_new, v_new, v_old);
+  }
 }
 
 // Per-particle J = det F_p and von Mises stress.
