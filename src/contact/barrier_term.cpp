@@ -133,6 +133,26 @@ void BarrierTerm<dim>::find_pairs(ConstDofView x, ConstDofView p, double pad) co
   } else {  // FEM points too: not against their own body
     n_pairs_ = hash_.query(particle_boxes_, pairs_, PairFilter<dim>{ps_, prims_});
   }
+  find_segments();
+}
+
+template <int dim>
+void BarrierTerm<dim>::find_segments() const {
+  if (static_cast<LO>(segments_.extent(0)) < n_pairs_ + 1)  // grows, not per call
+    segments_ = Kokkos::View<LO*, MemSpace>("contact_pair_segments", n_pairs_ + n_pairs_ / 4 + 16);
+  const auto pairs = pairs_;
+  const auto seg = segments_;
+  LO count = 0;
+  Kokkos::parallel_scan(
+      "contact_pair_segments", Kokkos::RangePolicy<ExecSpace>(0, n_pairs_),
+      KOKKOS_LAMBDA(const LO k, LO& offset, const bool final) {
+        const bool first = k == 0 || pairs(k, 0) != pairs(k - 1, 0);
+        if (first && final) seg(offset) = k;
+        offset += first ? 1 : 0;
+      },
+      count);
+  n_segments_ = count;
+  Kokkos::deep_copy(Kokkos::subview(seg, count), n_pairs_);
 }
 
 template <int dim>
@@ -241,29 +261,103 @@ void BarrierTerm<dim>::for_each_pair(ConstDofView x, const Body& body) const {
       });
 }
 
+// Per particle q with stencil weights w_a at nodes n_a, over its pairs with
+// local gradient g = (g_p, g_v1..) and Hessian H = [H_pp H_pv; H_vp H_vv]:
+// sum_a w_a sum_pairs g_p into node a, and the blocks w_a w_b sum_pairs H_pp
+// into (n_a, n_b), once per particle; the vertex parts (g_v, w_a H_pv, H_vv)
+// per pair. The same sums as expanding each pair alone (scatter_pair), in
+// another order: a particle with P pairs adds ns^2 + P (2 ns nv + nv^2)
+// blocks instead of P (ns + nv)^2.
+template <int dim>
+void BarrierTerm<dim>::assemble_by_particle(ConstDofView x, const Sink<dim>& sink, bool hessian) const {
+  ScopeTimer timer(timings_.evaluation_s);
+  interpolate_particles(ps_, x, xq_);
+  const auto pairs = pairs_;
+  const auto seg = segments_;
+  const auto prims = prims_;
+  const auto ps = ps_;
+  const ConstDofView xq = xq_;
+  const double dhat = dhat_, kappa = kappa_;
+  const bool matrix = hessian && sink.has_matrix();
+  const bool project = project_ && sink.project;
+  const double keep = sink.contact_keep;
+  constexpr int ns = ParticleStencils<dim>::ns;
+  Kokkos::parallel_for(
+      "barrier_pairs_by_particle", Kokkos::RangePolicy<ExecSpace>(0, n_segments_), KOKKOS_LAMBDA(const LO s) {
+        const LO q = pairs(seg(s), 0);
+        const Vec<dim> p = load_vec<dim>(xq, q);
+        Vec<dim> gp = Vec<dim>::Zero();
+        Mat<dim> Hpp = Mat<dim>::Zero();
+        bool any = false;
+        for (LO k = seg(s); k < seg(s + 1); ++k) {
+          const LO j = pairs(k, 1);
+          dispatch_nv<dim>(prims.count(j), [&](auto NV) {
+            constexpr int nv = decltype(NV)::value;
+            constexpr int L = (1 + nv) * dim;
+            Vec<dim> v[nv];
+            LO vn[nv];
+            for (int i = 0; i < nv; ++i) {
+              vn[i] = prims.nodes(j, i);
+              v[i] = load_vec<dim>(x, vn[i]);
+            }
+            if (!(stencil_distance2_value<dim, nv>(p, v) < dhat * dhat)) return;
+            const Distance2<L> d = stencil_distance2<dim, nv>(p, v);
+            Eigen::Matrix<double, L, 1> g;
+            SquareMat<L> H;
+            barrier_of_distance2<L>(d, dhat, kappa, ps.omega(q) * prims.coef(j), g, H);
+            any = true;
+            for (int c = 0; c < dim; ++c) gp(c) += g(c);
+            for (int i = 0; i < nv; ++i)
+              for (int c = 0; c < dim; ++c) sink.add_gradient(vn[i], c, g((1 + i) * dim + c));
+            if (!matrix) return;
+            if (project) project_psd<L>(H, keep);
+            for (int r = 0; r < dim; ++r)
+              for (int c = 0; c < dim; ++c) Hpp(r, c) += H(r, c);
+            for (int i = 0; i < nv; ++i) {
+              const int bi = (1 + i) * dim;
+              for (int l = 0; l < nv; ++l) {
+                const int bl = (1 + l) * dim;
+                sink.add_block(vn[i], vn[l], [&](int r, int c) { return H(bi + r, bl + c); });
+              }
+              for (int a = 0; a < ns; ++a) {
+                const double w = ps.w(q, a);
+                if (w == 0.0) continue;  // a B-spline weight of 0 adds nothing
+                const LO na = ps.nodes(q, a);
+                sink.add_block(na, vn[i], [&](int r, int c) { return w * H(r, bi + c); });
+                sink.add_block(vn[i], na, [&](int r, int c) { return w * H(bi + r, c); });
+              }
+            }
+          });
+        }
+        if (!any) return;
+        for (int a = 0; a < ns; ++a) {
+          const double wa = ps.w(q, a);
+          if (wa == 0.0) continue;
+          const LO na = ps.nodes(q, a);
+          for (int c = 0; c < dim; ++c) sink.add_gradient(na, c, wa * gp(c));
+          if (!matrix) continue;
+          for (int b = 0; b < ns; ++b) {
+            const double wab = wa * ps.w(q, b);
+            if (wab == 0.0) continue;
+            sink.add_block(na, ps.nodes(q, b), [&](int r, int c) { return wab * Hpp(r, c); });
+          }
+        }
+      });
+}
+
 template <int dim>
 void BarrierTerm<dim>::gradient(ConstDofView x, double scale, DofView grad) const {
   if (n_pairs_ == 0) return;
   Sink<dim> sink;  // gradient only
   sink.grad = grad;
   sink.scale = scale;
-  for_each_pair(x, [=](LO, const PairDofs<dim>& pd, const auto& g, const auto&) {
-    constexpr int L = std::decay_t<decltype(g)>::RowsAtCompileTime;
-    scatter_pair<dim, L>(pd, g, static_cast<const SquareMat<L>*>(nullptr), sink);
-  });
+  assemble_by_particle(x, sink, false);
 }
 
 template <int dim>
 void BarrierTerm<dim>::assemble(ConstDofView x, const Sink<dim>& sink) const {
   if (n_pairs_ == 0) return;
-  const bool project = project_ && sink.project;
-  const double keep = sink.contact_keep;
-  for_each_pair(x, [=](LO, const PairDofs<dim>& pd, const auto& g, const auto& H) {
-    constexpr int L = std::decay_t<decltype(g)>::RowsAtCompileTime;
-    SquareMat<L> Hp = H;
-    if (project) project_psd<L>(Hp, keep);
-    scatter_pair<dim, L>(pd, g, &Hp, sink);
-  });
+  assemble_by_particle(x, sink, true);
 }
 
 template <int dim>

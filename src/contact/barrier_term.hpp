@@ -70,6 +70,12 @@ class BarrierTerm : public EnergyTerm<dim> {
   void find_pairs(ConstDofView x, ConstDofView p, double pad = -1.0) const;
   template <class Body>
   void for_each_pair(ConstDofView x, const Body& body) const;
+  // Segment starts of the (particle-sorted) pairs: one segment per particle.
+  void find_segments() const;
+  // Gradient (and with hessian the PSD-projected Hessian) of every pair, one
+  // particle's pairs at a time: their particle blocks are summed first and
+  // expanded through the particle's stencil once.
+  void assemble_by_particle(ConstDofView x, const Sink<dim>& sink, bool hessian) const;
 
   BoundaryPrimitives<dim> prims_;
   double dhat_, kappa_;
@@ -81,6 +87,8 @@ class BarrierTerm : public EnergyTerm<dim> {
   mutable Kokkos::View<double*, MemSpace> xq_, dq_;
   mutable Kokkos::View<LO* [2], MemSpace> pairs_;
   mutable LO n_pairs_ = 0;
+  mutable Kokkos::View<LO*, MemSpace> segments_;  // n_segments_ + 1 starts into pairs_ (capacity grows)
+  mutable LO n_segments_ = 0;
   mutable std::vector<long long> graph_keys_;  // q * n_prims + j, sorted
   mutable Kokkos::View<long long*, MemSpace> graph_keys_dev_;
   // (pair key, stencil base) of each begin_step pair, in the broad phase's
