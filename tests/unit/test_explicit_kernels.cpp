@@ -14,6 +14,7 @@
 #include <type_traits>
 #include <vector>
 
+#include "common/grid_fixtures.hpp"
 #include "kernels/explicit/contact_law.hpp"
 #include "kernels/explicit/logistic_regression.hpp"
 #include "kernels/explicit/shape_functions.hpp"
@@ -29,18 +30,6 @@ class ExplicitShapes : public ::testing::Test {};
 using Dims = ::testing::Types<std::integral_constant<int, 2>, std::integral_constant<int, 3>>;
 TYPED_TEST_SUITE(ExplicitShapes, Dims);
 
-template <int dim>
-GridSpec<dim> grid() {
-  GridSpec<dim> g;
-  const double o[3] = {-0.3, 0.7, 0.1};
-  for (int d = 0; d < dim; ++d) {
-    g.origin[d] = o[d];
-    g.n_cells[d] = 8;
-  }
-  g.dx = 0.1;
-  return g;
-}
-
 // Global nodal function of node n at x (sum over the stencil entries naming n).
 template <int dim, class Shape>
 double nodal(const GridSpec<dim>& g, LO n, const Vec<dim>& x, double l) {
@@ -53,7 +42,7 @@ double nodal(const GridSpec<dim>& g, LO n, const Vec<dim>& x, double l) {
 
 template <int dim, class Shape>
 void check_shape(double l) {
-  const GridSpec<dim> g = grid<dim>();
+  const GridSpec<dim> g = fixtures::small_grid<dim>();
   std::mt19937 rng(7);
   std::uniform_real_distribution<double> u(0.0, 1.0);
   int tested = 0;

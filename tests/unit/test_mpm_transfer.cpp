@@ -19,6 +19,7 @@
 #include <random>
 #include <type_traits>
 
+#include "common/grid_fixtures.hpp"
 #include "kernels/mpm_transfer.hpp"
 
 namespace {
@@ -29,18 +30,6 @@ template <class T>
 class MpmTransfer : public ::testing::Test {};
 using Dims = ::testing::Types<std::integral_constant<int, 2>, std::integral_constant<int, 3>>;
 TYPED_TEST_SUITE(MpmTransfer, Dims);
-
-template <int dim>
-GridSpec<dim> test_grid() {
-  GridSpec<dim> g;
-  const double o[3] = {-0.3, 0.7, 0.1};
-  for (int d = 0; d < dim; ++d) {
-    g.origin[d] = o[d];
-    g.n_cells[d] = 8;
-  }
-  g.dx = 0.1;
-  return g;
-}
 
 // n particles inside [origin + 2 dx, origin + 6 dx]^dim, random v, C, F near I.
 template <int dim>
@@ -65,7 +54,7 @@ Particles<dim> random_particles(const GridSpec<dim>& g, int n, unsigned seed) {
 
 template <int dim>
 void check_affine_g2p(TransferScheme scheme) {
-  const auto g = test_grid<dim>();
+  const auto g = fixtures::small_grid<dim>();
   auto p = random_particles<dim>(g, 40, 7);
   Kokkos::View<LO*, MemSpace> system_node("sn", g.num_nodes()), grid_node;
   const LO n = activate_grid<dim>(g, p, 0, system_node, grid_node);
@@ -150,7 +139,7 @@ Eigen::Vector3d cross3(const Vec<dim>& a, const Vec<dim>& b) {
 
 TYPED_TEST(MpmTransfer, P2GConservesMassMomentumAndApicAngularMomentum) {
   constexpr int dim = TypeParam::value;
-  const auto g = test_grid<dim>();
+  const auto g = fixtures::small_grid<dim>();
   const auto p = random_particles<dim>(g, 60, 11);
   Kokkos::View<LO*, MemSpace> system_node("sn", g.num_nodes()), grid_node;
   const LO n = activate_grid<dim>(g, p, 0, system_node, grid_node);
@@ -199,7 +188,7 @@ TYPED_TEST(MpmTransfer, P2GConservesMassMomentumAndApicAngularMomentum) {
 
 TYPED_TEST(MpmTransfer, P2GMatchesAPlainSumInParticleOrder) {
   constexpr int dim = TypeParam::value;
-  const auto g = test_grid<dim>();
+  const auto g = fixtures::small_grid<dim>();
   const auto p = random_particles<dim>(g, 500, 13);
   Kokkos::View<LO*, MemSpace> system_node("sn", g.num_nodes()), grid_node;
   const LO n = activate_grid<dim>(g, p, 0, system_node, grid_node);
