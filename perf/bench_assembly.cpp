@@ -8,6 +8,8 @@
 //                     projected (d+1)d square Hessian into the matrix, per
 //                     element, colored without atomics (what the simulation runs);
 //   fem_atomic        the same, all elements at once with atomic adds;
+//                     (on 1 thread both rows run all elements in index order
+//                     without atomics: DeformationTerm::assemble)
 // beside a STREAM-style copy (GB/s) measured in the same run, so that a slow
 // machine shows as a slow copy too. Each figure is the best of 5 calls on a
 // matrix from the DOF space (solver/dof_space.hpp), as the Newton solver

@@ -88,14 +88,21 @@ class DeformationTerm : public EnergyTerm<dim> {
     deformation_gradient(s_, x, scale, grad);
   }
   // Colored (set_coloring): color by color, without atomics; otherwise all
-  // stencils at once with atomic adds.
+  // stencils at once with atomic adds. On one thread: all stencils in index
+  // order without atomics (no other thread to race with; the colors' jumps
+  // through the mesh cost 10 % at 1 thread, perf/README.md "Assembly per stencil").
   void assemble(ConstDofView x, const Sink<dim>& sink) const override {
+    Sink<dim> plain = sink;
+    plain.atomic = false;
+    if (ExecSpace().concurrency() == 1) {
+      deformation_assemble(s_, x, plain, project_ && sink.project);
+      return;
+    }
     if (coloring_.colors() == 0) {
       deformation_assemble(s_, x, sink, project_ && sink.project);
       return;
     }
-    Sink<dim> plain = sink;
-    plain.atomic = false;  // the stencils of one color share no node
+    // the stencils of one color share no node
     for (int c = 0; c < coloring_.colors(); ++c)
       deformation_assemble(s_, x, plain, project_ && sink.project, coloring_.order, coloring_.color_start[c],
                            coloring_.color_start[c + 1]);
