@@ -85,11 +85,18 @@ struct DofSink {
   }
 
   // Hessian block of nodes (a, b): h(i, j) for i, j < dim, before scaling.
+  // hint: a guess at b's block position in a's rows (checked, then searched
+  // if wrong), e.g. the previous block's + dim when a stencil's nodes run
+  // consecutively. Returns the position used (-1: none was needed or found).
   template <class H>
-  KOKKOS_INLINE_FUNCTION void add_block(ordinal a, ordinal b, const H& h) const {
+  KOKKOS_INLINE_FUNCTION long add_block(ordinal a, ordinal b, const H& h, long hint = -1) const {
     const size_type r0 = A.graph.row_map(a * dim);
     const size_type len = A.graph.row_map(a * dim + 1) - r0;
     long pos = -2;  // found lazily: a block of prescribed rows needs no position
+    auto find = [&]() {
+      if (hint >= 0 && static_cast<size_type>(hint) < len && A.graph.entries(r0 + hint) == b * dim) return hint;
+      return block_position(a, b);
+    };
     for (int i = 0; i < dim; ++i) {
       const ordinal row = a * dim + i;
       if (prescribed(row)) continue;
@@ -101,7 +108,7 @@ struct DofSink {
           r -= v * dx_prescribed(col);
         } else {
           if (pos == -2) {
-            pos = block_position(a, b);
+            pos = find();
             if (pos < 0 && dropped.data()) Kokkos::atomic_increment(&dropped());
           }
           if (pos >= 0) add(A.values(r0 + i * len + pos + j), v);
@@ -109,6 +116,7 @@ struct DofSink {
       }
       if (r != 0) add(rhs(row), r);
     }
+    return pos >= 0 ? pos : -1;
   }
 
   // A whole stencil of k nodes: g(r), r < k dim; H(r, c), r, c < k dim.

@@ -67,6 +67,25 @@ void interpolate_particles(const ParticleStencils<dim>& ps, Kokkos::View<const d
       });
 }
 
+// Runs of equal particle in a pair list (pairs(k, 0) = particle): seg(s) is
+// the first pair of run s, seg(count) = n; returns count. Pairs sorted by
+// particle (as the broad phase returns them) give one run per particle;
+// unsorted ones only more runs. seg grows (with headroom) when too small.
+inline LO particle_segments(const Kokkos::View<LO* [2], MemSpace>& pairs, LO n, Kokkos::View<LO*, MemSpace>& seg) {
+  if (static_cast<LO>(seg.extent(0)) < n + 1) seg = Kokkos::View<LO*, MemSpace>("pair_segments", n + n / 4 + 16);
+  const auto out = seg;
+  LO count = 0;
+  Kokkos::parallel_scan(
+      "pair_segments", Kokkos::RangePolicy<ExecSpace>(0, n), KOKKOS_LAMBDA(const LO k, LO& offset, const bool final) {
+        const bool first = k == 0 || pairs(k, 0) != pairs(k - 1, 0);
+        if (first && final) out(offset) = k;
+        offset += first ? 1 : 0;
+      },
+      count);
+  Kokkos::deep_copy(Kokkos::subview(out, count), n);
+  return count;
+}
+
 template <int dim>
 KOKKOS_INLINE_FUNCTION Vec<dim> load_vec(const Kokkos::View<const double*, MemSpace>& x, LO node) {
   Vec<dim> v;

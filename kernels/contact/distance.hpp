@@ -17,11 +17,21 @@
 
 namespace bfemp {
 
+// d2 with its gradient and Hessian in the stacked stencil variables, and
+// the subspace that holds the range of both (see the derivatives below):
+//   grad = 2 c (x) w,   hess = 2 (c c^T (x) I) - 2 N G^-1 N^T,
+// so grad and hess (and any f'(d2) hess + f''(d2) grad grad^T) map into
+//   span{ c (x) e_k : k < dim } + span{ columns of N },
+// at most dim + nb dimensions of the n = nv dim variables. c holds the
+// nv = n / dim stencil coefficients; N's first nb columns are used.
 template <int n>
 struct Distance2 {
   double d2;
   Eigen::Matrix<double, n, 1> grad;
   Eigen::Matrix<double, n, n> hess;
+  double c[4] = {0, 0, 0, 0};
+  Eigen::Matrix<double, n, 2> N;
+  int nb = 0;
 };
 
 // Closest feature of the edge (e0, e1) to p: an endpoint or the interior.
@@ -205,8 +215,10 @@ namespace contact_detail {
 template <int dim, int nv>
 KOKKOS_INLINE_FUNCTION Distance2<nv * dim> stencil_distance2(const Vec<dim>& w,
                                                              const Eigen::Matrix<double, nv, 1>& c) {
+  static_assert(nv <= 4, "at most 4 stencil vertices");
   Distance2<nv * dim> out;
   out.d2 = w.squaredNorm();
+  for (int i = 0; i < nv; ++i) out.c[i] = c(i);
   for (int i = 0; i < nv; ++i) {
     out.grad.template segment<dim>(i * dim) = 2 * c(i) * w;
     for (int j = 0; j < nv; ++j)
@@ -227,6 +239,8 @@ KOKKOS_INLINE_FUNCTION Distance2<nv * dim> stencil_distance2(const Vec<dim>& w,
   for (int k = 0; k < nb; ++k)
     for (int i = 0; i < nv; ++i) N.template block<dim, 1>(i * dim, k) = dc(i, k) * w + c(i) * U.col(k);
   out.hess -= 2 * N * Ginv * N.transpose();
+  out.N.template leftCols<nb>() = N;
+  out.nb = nb;
   return out;
 }
 

@@ -8,7 +8,7 @@
 
 #include "contact/pair_couplings.hpp"
 #include "kernels/contact/ccd.hpp"
-#include "materials/psd_projection.hpp"
+#include "kernels/contact/pair_projection.hpp"
 
 namespace bfemp {
 
@@ -138,21 +138,7 @@ void BarrierTerm<dim>::find_pairs(ConstDofView x, ConstDofView p, double pad) co
 
 template <int dim>
 void BarrierTerm<dim>::find_segments() const {
-  if (static_cast<LO>(segments_.extent(0)) < n_pairs_ + 1)  // grows, not per call
-    segments_ = Kokkos::View<LO*, MemSpace>("contact_pair_segments", n_pairs_ + n_pairs_ / 4 + 16);
-  const auto pairs = pairs_;
-  const auto seg = segments_;
-  LO count = 0;
-  Kokkos::parallel_scan(
-      "contact_pair_segments", Kokkos::RangePolicy<ExecSpace>(0, n_pairs_),
-      KOKKOS_LAMBDA(const LO k, LO& offset, const bool final) {
-        const bool first = k == 0 || pairs(k, 0) != pairs(k - 1, 0);
-        if (first && final) seg(offset) = k;
-        offset += first ? 1 : 0;
-      },
-      count);
-  n_segments_ = count;
-  Kokkos::deep_copy(Kokkos::subview(seg, count), n_pairs_);
+  n_segments_ = particle_segments(pairs_, n_pairs_, segments_);
 }
 
 template <int dim>
@@ -267,10 +253,14 @@ void BarrierTerm<dim>::for_each_pair(ConstDofView x, const Body& body) const {
 // into (n_a, n_b), once per particle; the vertex parts (g_v, w_a H_pv, H_vv)
 // per pair. The same sums as expanding each pair alone (scatter_pair), in
 // another order: a particle with P pairs adds ns^2 + P (2 ns nv + nv^2)
-// blocks instead of P (ns + nv)^2.
+// blocks instead of P (ns + nv)^2. On one thread the adds are plain (no
+// other thread to race with; an atomic add on a double is a locked
+// compare-and-swap loop on x86), in the same order, so the sums are the same.
 template <int dim>
-void BarrierTerm<dim>::assemble_by_particle(ConstDofView x, const Sink<dim>& sink, bool hessian) const {
+void BarrierTerm<dim>::assemble_by_particle(ConstDofView x, const Sink<dim>& sink_in, bool hessian) const {
   ScopeTimer timer(timings_.evaluation_s);
+  Sink<dim> sink = sink_in;
+  if (ExecSpace().concurrency() == 1) sink.atomic = false;
   interpolate_particles(ps_, x, xq_);
   const auto pairs = pairs_;
   const auto seg = segments_;
@@ -310,7 +300,7 @@ void BarrierTerm<dim>::assemble_by_particle(ConstDofView x, const Sink<dim>& sin
             for (int i = 0; i < nv; ++i)
               for (int c = 0; c < dim; ++c) sink.add_gradient(vn[i], c, g((1 + i) * dim + c));
             if (!matrix) return;
-            if (project) project_psd<L>(H, keep);
+            if (project) project_pair_hessian<dim, L>(d, H, keep);
             for (int r = 0; r < dim; ++r)
               for (int c = 0; c < dim; ++c) Hpp(r, c) += H(r, c);
             for (int i = 0; i < nv; ++i) {
@@ -336,10 +326,17 @@ void BarrierTerm<dim>::assemble_by_particle(ConstDofView x, const Sink<dim>& sin
           const LO na = ps.nodes(q, a);
           for (int c = 0; c < dim; ++c) sink.add_gradient(na, c, wa * gp(c));
           if (!matrix) continue;
+          // Stencil nodes in a row of the grid are usually consecutive ids,
+          // and then consecutive blocks of na's rows: hint the next position.
+          long pos = -1;
+          LO prev = -1;
           for (int b = 0; b < ns; ++b) {
             const double wab = wa * ps.w(q, b);
             if (wab == 0.0) continue;
-            sink.add_block(na, ps.nodes(q, b), [&](int r, int c) { return wab * Hpp(r, c); });
+            const LO nb = ps.nodes(q, b);
+            const long hint = (pos >= 0 && nb == prev + 1) ? pos + dim : -1;
+            pos = sink.add_block(na, nb, [&](int r, int c) { return wab * Hpp(r, c); }, hint);
+            prev = nb;
           }
         }
       });

@@ -81,6 +81,7 @@ LO FrictionTerm<dim>::update_lagged(ConstDofView x, ConstDofView x_ref, double s
         acc += ml(k) != 0 ? 1 : 0;
       },
       nonzero);
+  n_seg_ = particle_segments(pair_, n_, seg_);
   return nonzero;
 }
 
@@ -164,66 +165,98 @@ double FrictionTerm<dim>::energy(ConstDofView x) const {
   return e;
 }
 
-namespace {
-
-// Local gradient and Hessian of mu lambda f0(|u|) in the stacked positions
-// (particle, vertices): block i = s c_i T (f1/y) u; block (i, i') = s^2 c_i
-// c_i' T H_u T^T.
-template <int dim, int nv, class CV>
-KOKKOS_INLINE_FUNCTION void friction_local(const CV& c, LO k, double ml, double s, double eh,
-                                           const Eigen::Matrix<double, dim - 1, 1>& u,
-                                           const Eigen::Matrix<double, dim, dim - 1>& T,
-                                           Eigen::Matrix<double, (1 + nv) * dim, 1>& g,
-                                           SquareMat<(1 + nv) * dim>* H) {
-  const double y = u.norm();
-  const Vec<dim> f = ml * friction_f1_over_y(y, eh) * (T * u);
-  for (int i = 0; i <= nv; ++i) g.template segment<dim>(i * dim) = s * c(k, i) * f;
-  if (!H) return;
-  H->setZero();
-  if (!(ml > 0)) return;  // a compensation pair: its (negative) Hessian projects to zero
-  const Mat<dim> Hx = ml * s * s * (T * friction_f0_hessian<dim - 1>(u, eh) * T.transpose());
-  for (int i = 0; i <= nv; ++i)
-    for (int l = 0; l <= nv; ++l) H->template block<dim, dim>(i * dim, l * dim) = c(k, i) * c(k, l) * Hx;
+// Per particle q with stencil weights w_a at nodes n_a, over its lagged
+// pairs k with coefficients c_k0 (particle), c_ki (vertices):
+//   pair force     f_k = mu lambda_k (f1/y) T_k u_k,
+//   pair Hessian   Hx_k = mu lambda_k s^2 T_k H_u T_k^T   (mu lambda_k > 0 only),
+// the particle's sums s sum_k c_k0 f_k and sum_k c_k0^2 Hx_k are expanded
+// through the stencil once; the vertex parts (s c_ki f_k, c_ki c_kl Hx_k,
+// w_a c_k0 c_ki Hx_k) go per pair. The same sums as expanding each pair's
+// local gradient s c_i f and Hessian c_i c_l Hx through the stencil, in
+// another order. On one thread the adds are plain (see the barrier term).
+template <int dim>
+void FrictionTerm<dim>::assemble_by_particle(ConstDofView x, const Sink<dim>& sink_in, bool hessian) const {
+  Sink<dim> sink = sink_in;
+  if (ExecSpace().concurrency() == 1) sink.atomic = false;
+  const FrictionSliding<dim> sl = sliding(x);
+  const auto ps = barrier_.particles();
+  const auto seg = seg_;
+  const auto c = c_;
+  const auto ml = ml_;
+  const double s = s_, eh = eh_;
+  const bool matrix = hessian && sink.has_matrix();
+  constexpr int ns = ParticleStencils<dim>::ns;
+  Kokkos::parallel_for(
+      "friction_pairs_by_particle", Kokkos::RangePolicy<ExecSpace>(0, n_seg_), KOKKOS_LAMBDA(const LO r) {
+        const LO q = sl.pair(seg(r), 0);
+        Vec<dim> gp = Vec<dim>::Zero();
+        Mat<dim> Hpp = Mat<dim>::Zero();
+        for (LO k = seg(r); k < seg(r + 1); ++k) {
+          const LO j = sl.pair(k, 1);
+          const int nv = sl.prims.count(j);
+          Eigen::Matrix<double, dim, dim - 1> T;
+          Eigen::Matrix<double, dim - 1, 1> u;
+          sl(k, T, u);
+          const Vec<dim> f = ml(k) * friction_f1_over_y(u.norm(), eh) * (T * u);
+          gp += (s * c(k, 0)) * f;
+          LO vn[dim];
+          for (int i = 0; i < nv; ++i) {
+            vn[i] = sl.prims.nodes(j, i);
+            for (int d = 0; d < dim; ++d) sink.add_gradient(vn[i], d, s * c(k, 1 + i) * f(d));
+          }
+          // A compensation pair (mu lambda < 0): its negative Hessian projects to zero.
+          if (!matrix || !(ml(k) > 0)) continue;
+          const Mat<dim> Hx = ml(k) * s * s * (T * friction_f0_hessian<dim - 1>(u, eh) * T.transpose());
+          const double c0 = c(k, 0);
+          Hpp += (c0 * c0) * Hx;
+          for (int i = 0; i < nv; ++i) {
+            const double ci = c(k, 1 + i);
+            for (int l = 0; l < nv; ++l) {
+              const double cil = ci * c(k, 1 + l);
+              sink.add_block(vn[i], vn[l], [&](int a, int b) { return cil * Hx(a, b); });
+            }
+            for (int a = 0; a < ns; ++a) {
+              const double w = ps.w(q, a) * c0 * ci;
+              if (w == 0.0) continue;  // a B-spline weight of 0 adds nothing
+              const LO na = ps.nodes(q, a);
+              sink.add_block(na, vn[i], [&](int ra, int cb) { return w * Hx(ra, cb); });
+              sink.add_block(vn[i], na, [&](int ra, int cb) { return w * Hx(ra, cb); });
+            }
+          }
+        }
+        for (int a = 0; a < ns; ++a) {
+          const double wa = ps.w(q, a);
+          if (wa == 0.0) continue;
+          const LO na = ps.nodes(q, a);
+          for (int d = 0; d < dim; ++d) sink.add_gradient(na, d, wa * gp(d));
+          if (!matrix) continue;
+          long pos = -1;  // consecutive stencil nodes: hint the next block's position
+          LO prev = -1;
+          for (int b = 0; b < ns; ++b) {
+            const double wab = wa * ps.w(q, b);
+            if (wab == 0.0) continue;
+            const LO nb = ps.nodes(q, b);
+            const long hint = (pos >= 0 && nb == prev + 1) ? pos + dim : -1;
+            pos = sink.add_block(na, nb, [&](int ra, int cb) { return wab * Hpp(ra, cb); }, hint);
+            prev = nb;
+          }
+        }
+      });
 }
-
-}  // namespace
 
 template <int dim>
 void FrictionTerm<dim>::gradient(ConstDofView x, double scale, DofView grad) const {
   if (n_ == 0) return;
-  const auto c = c_;
-  const auto ml = ml_;
-  const double s = s_, eh = eh_;
   Sink<dim> sink;  // gradient only
   sink.grad = grad;
   sink.scale = scale;
-  for_each_pair(x, [=](LO k, LO, const PairDofs<dim>& pd, const auto& u, const auto& T) {
-    dispatch_nv<dim>(pd.nv, [&](auto NV) {
-      constexpr int nv = decltype(NV)::value;
-      constexpr int L = (1 + nv) * dim;
-      Eigen::Matrix<double, L, 1> g;
-      friction_local<dim, nv>(c, k, ml(k), s, eh, u, T, g, static_cast<SquareMat<L>*>(nullptr));
-      scatter_pair<dim, L>(pd, g, static_cast<const SquareMat<L>*>(nullptr), sink);
-    });
-  });
+  assemble_by_particle(x, sink, false);
 }
 
 template <int dim>
 void FrictionTerm<dim>::assemble(ConstDofView x, const Sink<dim>& sink) const {
   if (n_ == 0) return;
-  const auto c = c_;
-  const auto ml = ml_;
-  const double s = s_, eh = eh_;
-  for_each_pair(x, [=](LO k, LO, const PairDofs<dim>& pd, const auto& u, const auto& T) {
-    dispatch_nv<dim>(pd.nv, [&](auto NV) {
-      constexpr int nv = decltype(NV)::value;
-      constexpr int L = (1 + nv) * dim;
-      Eigen::Matrix<double, L, 1> g;
-      SquareMat<L> H;
-      friction_local<dim, nv>(c, k, ml(k), s, eh, u, T, g, &H);
-      scatter_pair<dim, L>(pd, g, &H, sink);
-    });
-  });
+  assemble_by_particle(x, sink, true);
 }
 
 template <int dim>
@@ -232,14 +265,9 @@ void FrictionTerm<dim>::add_particle_forces(ConstDofView x, DofView f) const {
   const auto c = c_;
   const auto ml = ml_;
   const double s = s_, eh = eh_;
-  for_each_pair(x, [=](LO k, LO q, const PairDofs<dim>& pd, const auto& u, const auto& T) {
-    dispatch_nv<dim>(pd.nv, [&](auto NV) {
-      constexpr int nv = decltype(NV)::value;
-      constexpr int L = (1 + nv) * dim;
-      Eigen::Matrix<double, L, 1> g;
-      friction_local<dim, nv>(c, k, ml(k), s, eh, u, T, g, static_cast<SquareMat<L>*>(nullptr));
-      for (int d = 0; d < dim; ++d) Kokkos::atomic_add(&f(q * dim + d), -g(d));
-    });
+  for_each_pair(x, [=](LO k, LO q, const PairDofs<dim>&, const auto& u, const auto& T) {
+    const Vec<dim> fk = ml(k) * friction_f1_over_y(u.norm(), eh) * (T * u);
+    for (int d = 0; d < dim; ++d) Kokkos::atomic_add(&f(q * dim + d), -s * c(k, 0) * fk(d));
   });
 }
 

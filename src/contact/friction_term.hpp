@@ -42,6 +42,9 @@ class FrictionTerm : public EnergyTerm<dim> {
  private:
   template <class Body>
   void for_each_pair(ConstDofView x, const Body& body) const;
+  // Gradient (and with `hessian` the matrix) into the sink, one particle's
+  // pairs at a time (as BarrierTerm::assemble_by_particle).
+  void assemble_by_particle(ConstDofView x, const Sink<dim>& sink, bool hessian) const;
   FrictionSliding<dim> sliding(ConstDofView x) const;
 
   const BarrierTerm<dim>& barrier_;
@@ -55,6 +58,8 @@ class FrictionTerm : public EnergyTerm<dim> {
   Kokkos::View<double* [dim][dim - 1], MemSpace> T_;
   Kokkos::View<double*, MemSpace> ml_;            // mu * lambda
   LO n_ = 0;
+  Kokkos::View<LO*, MemSpace> seg_;  // n_seg_ + 1 starts of each particle's pairs (capacity grows)
+  LO n_seg_ = 0;
   mutable Kokkos::View<double*, MemSpace> xq_, xq_ref_;
 };
 
