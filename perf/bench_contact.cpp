@@ -2,8 +2,9 @@
 // ~n_facets boundary edges, under a layer of n_particles MPM particles whose
 // first rows lie within dhat. Per case: broad phase (static pairs at x and
 // swept pairs along a direction), pair evaluation (barrier gradient + PSD
-// Hessian assembled into a Tpetra matrix) in active pairs per second, and
-// the CCD step bound over the swept pairs. Threads follow OMP_NUM_THREADS
+// Hessian assembled into a Tpetra matrix) in active pairs per second, the
+// lagged friction term's gradient + Hessian over the same pairs (mu 0.5,
+// every pair sliding), and the CCD step bound over the swept pairs. Threads follow OMP_NUM_THREADS
 // (perf/run_contact.sh runs 1 and 2).   Writes JSON:  bench_contact [--out FILE]
 #include <Kokkos_Core.hpp>
 #include <Kokkos_Timer.hpp>
@@ -82,6 +83,7 @@ std::string bench(long n_particles, long n_facets) {
   ContactParams cp;
   cp.dhat = dhat;
   cp.kappa = 1e5;
+  cp.mu = {0.5};
   Contact<2> contact(mesh, cp);
   contact.begin_step(mpm, x);
   const auto* barrier = contact.barrier();
@@ -89,8 +91,18 @@ std::string bench(long n_particles, long n_facets) {
   const LO candidates = barrier->candidate_pairs();
   const LO active = barrier->active_pairs(x).count;
   barrier->update(x);
+  // Friction lagged at x, against a reference shifted along the strip: every
+  // pair slides (|u| > eps_v dt).
+  Kokkos::View<double*, MemSpace> xref("xref", nn * 2);
+  Kokkos::parallel_for(
+      "bench_xref", Kokkos::RangePolicy<ExecSpace>(0, nn * 2), KOKKOS_LAMBDA(const LO i) {
+        xref(i) = x(i) - (i % 2 == 0 ? 0.05 * hp : 0.0);
+      });
+  const LO friction_pairs = contact.update_friction(x, xref, 1.0, 1e-3);
+  const auto* friction = contact.friction();
   std::vector<long long> keys;
   barrier->add_couplings(keys, nn);
+  friction->add_couplings(keys, nn);
   auto map = Teuchos::rcp(new Map(static_cast<Tpetra::global_size_t>(nn * 2), 0, Tpetra::getDefaultComm()));
   auto A = Teuchos::rcp(new Matrix(build_dof_graph<2>(keys, nn, map)));
   A->fillComplete();
@@ -99,6 +111,7 @@ std::string bench(long n_particles, long n_facets) {
   A->resumeFill();
   const auto lcl = A->getLocalMatrixDevice();
   const double t_eval = best_time([&] { barrier->assemble(x, make_sink<2>(lcl, 1.0, grad, rhs, pres, dxp)); });
+  const double t_friction = best_time([&] { friction->assemble(x, make_sink<2>(lcl, 1.0, grad, rhs, pres, dxp)); });
   const double t_swept = best_time([&] { barrier->prepare_direction(x, dir); });
   const LO swept = barrier->candidate_pairs();
   double alpha = 0;
@@ -107,11 +120,13 @@ std::string bench(long n_particles, long n_facets) {
   j << "{\"particles\": " << cols * rows << ", \"boundary_primitives\": " << barrier->primitives().size()
     << ", \"facets\": " << barrier->primitives().num_facets << ", \"candidate_pairs\": " << candidates
     << ", \"active_pairs\": " << active << ", \"broad_phase_s\": " << t_broad << ", \"eval_s\": " << t_eval
-    << ", \"pairs_per_s\": " << active / t_eval << ", \"swept_pairs\": " << swept
+    << ", \"pairs_per_s\": " << active / t_eval << ", \"friction_pairs\": " << friction_pairs
+    << ", \"friction_s\": " << t_friction << ", \"swept_pairs\": " << swept
     << ", \"swept_broad_phase_s\": " << t_swept << ", \"ccd_s\": " << t_ccd << ", \"ccd_alpha\": " << alpha << "}";
   std::cout << "  " << cols * rows << " particles, " << barrier->primitives().num_facets << " facets: broad phase "
             << t_broad * 1e3 << " ms (" << candidates << " candidates, " << active << " active), gradient+Hessian "
-            << t_eval * 1e3 << " ms (" << active / t_eval / 1e6 << " M pairs/s), swept broad phase " << t_swept * 1e3
+            << t_eval * 1e3 << " ms (" << active / t_eval / 1e6 << " M pairs/s), friction " << t_friction * 1e3
+            << " ms (" << friction_pairs << " pairs), swept broad phase " << t_swept * 1e3
             << " ms (" << swept << "), CCD " << t_ccd * 1e3 << " ms (alpha " << alpha << ")\n"
             << std::flush;
   return j.str();

@@ -2,7 +2,7 @@
 # Runs bench_contact at 1 and 2 threads; writes build/perf/contact.json (or the
 # file given as $1; pass perf/baselines/contact.json to record a new baseline,
 # on a quiet machine). Needs a build in ./build. Compare with the baseline:
-#   python3 perf/compare.py build/perf/contact.json --baseline perf/baselines/contact.json --fields FIELDS
+#   python3 perf/compare.py build/perf/contact.json --baseline perf/baselines/contact.json --fields eval_s,friction_s
 set -euo pipefail
 cd "$(dirname "$0")/.."
 out=${1:-build/perf/contact.json}
