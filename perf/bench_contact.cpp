@@ -4,7 +4,7 @@
 // swept pairs along a direction), pair evaluation (barrier gradient + PSD
 // Hessian assembled into a Tpetra matrix) in active pairs per second, the
 // lagged friction term's gradient + Hessian over the same pairs (mu 0.5,
-// every pair sliding), and the CCD step bound over the swept pairs. Threads follow OMP_NUM_THREADS
+// every pair static), and the CCD step bound over the swept pairs. Threads follow OMP_NUM_THREADS
 // (perf/run_contact.sh runs 1 and 2).   Writes JSON:  bench_contact [--out FILE]
 #include <Kokkos_Core.hpp>
 #include <Kokkos_Timer.hpp>
@@ -91,8 +91,10 @@ std::string bench(long n_particles, long n_facets) {
   const LO candidates = barrier->candidate_pairs();
   const LO active = barrier->active_pairs(x).count;
   barrier->update(x);
-  // Friction lagged at x, against a reference shifted along the strip: every
-  // pair slides (|u| > eps_v dt).
+  // Friction lagged at x against x shifted along the strip, grid and strip
+  // alike: the relative slide cancels, so every pair is in the static
+  // (mollified) branch, whose tangent Hessian is not zero (in 2D the sliding
+  // branch's is: f1' = 0), the costlier case to assemble.
   Kokkos::View<double*, MemSpace> xref("xref", nn * 2);
   Kokkos::parallel_for(
       "bench_xref", Kokkos::RangePolicy<ExecSpace>(0, nn * 2), KOKKOS_LAMBDA(const LO i) {

@@ -18,19 +18,21 @@
 namespace bfemp {
 
 // d2 with its gradient and Hessian in the stacked stencil variables, and
-// the subspace that holds the range of both (see the derivatives below):
+// what spans the range of both (see the derivatives below):
 //   grad = 2 c (x) w,   hess = 2 (c c^T (x) I) - 2 N G^-1 N^T,
+//   N's column k = dc_k (x) w + c (x) u_k,
 // so grad and hess (and any f'(d2) hess + f''(d2) grad grad^T) map into
-//   span{ c (x) e_k : k < dim } + span{ columns of N },
-// at most dim + nb dimensions of the n = nv dim variables. c holds the
-// nv = n / dim stencil coefficients; N's first nb columns are used.
+//   span{ c (x) e_k : k < dim } + span{ dc_k (x) w : k < nb },
+// at most dim + nb dimensions of the n = nv dim variables (c (x) u_k lies
+// in the first part). c and dc hold nv = n / dim stencil coefficients each;
+// c[0] = 1 (the point), so w = grad's first block / 2.
 template <int n>
 struct Distance2 {
   double d2;
   Eigen::Matrix<double, n, 1> grad;
   Eigen::Matrix<double, n, n> hess;
   double c[4] = {0, 0, 0, 0};
-  Eigen::Matrix<double, n, 2> N;
+  double dc[2][4] = {{0, 0, 0, 0}, {0, 0, 0, 0}};
   int nb = 0;
 };
 
@@ -239,7 +241,8 @@ KOKKOS_INLINE_FUNCTION Distance2<nv * dim> stencil_distance2(const Vec<dim>& w,
   for (int k = 0; k < nb; ++k)
     for (int i = 0; i < nv; ++i) N.template block<dim, 1>(i * dim, k) = dc(i, k) * w + c(i) * U.col(k);
   out.hess -= 2 * N * Ginv * N.transpose();
-  out.N.template leftCols<nb>() = N;
+  for (int k = 0; k < nb; ++k)
+    for (int i = 0; i < nv; ++i) out.dc[k][i] = dc(i, k);
   out.nb = nb;
   return out;
 }
