@@ -7,6 +7,7 @@
 #include <type_traits>
 
 #include "contact/pair_couplings.hpp"
+#include "contact/particle_expansion.hpp"
 #include "kernels/contact/ccd.hpp"
 #include "kernels/contact/pair_projection.hpp"
 
@@ -320,25 +321,7 @@ void BarrierTerm<dim>::assemble_by_particle(ConstDofView x, const Sink<dim>& sin
           });
         }
         if (!any) return;
-        for (int a = 0; a < ns; ++a) {
-          const double wa = ps.w(q, a);
-          if (wa == 0.0) continue;
-          const LO na = ps.nodes(q, a);
-          for (int c = 0; c < dim; ++c) sink.add_gradient(na, c, wa * gp(c));
-          if (!matrix) continue;
-          // Stencil nodes in a row of the grid are usually consecutive ids,
-          // and then consecutive blocks of na's rows: hint the next position.
-          long pos = -1;
-          LO prev = -1;
-          for (int b = 0; b < ns; ++b) {
-            const double wab = wa * ps.w(q, b);
-            if (wab == 0.0) continue;
-            const LO nb = ps.nodes(q, b);
-            const long hint = (pos >= 0 && nb == prev + 1) ? pos + dim : -1;
-            pos = sink.add_block(na, nb, [&](int r, int c) { return wab * Hpp(r, c); }, hint);
-            prev = nb;
-          }
-        }
+        expand_particle_sums<dim>(ps, q, gp, Hpp, matrix, sink);
       });
 }
 

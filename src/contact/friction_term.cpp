@@ -4,6 +4,7 @@
 #include <type_traits>
 
 #include "contact/pair_couplings.hpp"
+#include "contact/particle_expansion.hpp"
 #include "kernels/contact/friction.hpp"
 
 namespace bfemp {
@@ -224,23 +225,7 @@ void FrictionTerm<dim>::assemble_by_particle(ConstDofView x, const Sink<dim>& si
             }
           }
         }
-        for (int a = 0; a < ns; ++a) {
-          const double wa = ps.w(q, a);
-          if (wa == 0.0) continue;
-          const LO na = ps.nodes(q, a);
-          for (int d = 0; d < dim; ++d) sink.add_gradient(na, d, wa * gp(d));
-          if (!matrix) continue;
-          long pos = -1;  // consecutive stencil nodes: hint the next block's position
-          LO prev = -1;
-          for (int b = 0; b < ns; ++b) {
-            const double wab = wa * ps.w(q, b);
-            if (wab == 0.0) continue;
-            const LO nb = ps.nodes(q, b);
-            const long hint = (pos >= 0 && nb == prev + 1) ? pos + dim : -1;
-            pos = sink.add_block(na, nb, [&](int ra, int cb) { return wab * Hpp(ra, cb); }, hint);
-            prev = nb;
-          }
-        }
+        expand_particle_sums<dim>(ps, q, gp, Hpp, matrix, sink);
       });
 }
 
