@@ -129,22 +129,12 @@ FrictionSliding<dim> FrictionTerm<dim>::sliding(ConstDofView x) const {
   return {x, xq_, xq_ref_, x_ref_, barrier_.primitives(), pair_, c_, T_, s_};
 }
 
-// body(k, q, pd, u, Tk): u the sliding displacement, per lagged pair.
+// The lagged pair's friction force direction times its magnitude,
+// mu lambda (f1(|u|)/|u|) T u (its gradient in the sliding displacement).
 template <int dim>
-template <class Body>
-void FrictionTerm<dim>::for_each_pair(ConstDofView x, const Body& body) const {
-  const FrictionSliding<dim> sl = sliding(x);
-  const auto psc = barrier_.particles();
-  Kokkos::parallel_for(
-      "friction_pairs", Kokkos::RangePolicy<ExecSpace>(0, n_), KOKKOS_LAMBDA(const LO k) {
-        const LO q = sl.pair(k, 0), j = sl.pair(k, 1);
-        Eigen::Matrix<double, dim, dim - 1> Tk;
-        Eigen::Matrix<double, dim - 1, 1> u;
-        sl(k, Tk, u);
-        PairDofs<dim> pd;
-        fill_pair_dofs<dim>(psc, sl.prims, q, j, sl.prims.count(j), pd);
-        body(k, q, pd, u, Tk);
-      });
+KOKKOS_INLINE_FUNCTION Vec<dim> friction_pair_force(double ml, double eh, const Eigen::Matrix<double, dim - 1, 1>& u,
+                                                    const Eigen::Matrix<double, dim, dim - 1>& T) {
+  return ml * friction_f1_over_y(u.norm(), eh) * (T * u);
 }
 
 template <int dim>
@@ -198,7 +188,7 @@ void FrictionTerm<dim>::assemble_by_particle(ConstDofView x, const Sink<dim>& si
           Eigen::Matrix<double, dim, dim - 1> T;
           Eigen::Matrix<double, dim - 1, 1> u;
           sl(k, T, u);
-          const Vec<dim> f = ml(k) * friction_f1_over_y(u.norm(), eh) * (T * u);
+          const Vec<dim> f = friction_pair_force<dim>(ml(k), eh, u, T);
           gp += (s * c(k, 0)) * f;
           LO vn[dim];
           for (int i = 0; i < nv; ++i) {
@@ -247,13 +237,19 @@ void FrictionTerm<dim>::assemble(ConstDofView x, const Sink<dim>& sink) const {
 template <int dim>
 void FrictionTerm<dim>::add_particle_forces(ConstDofView x, DofView f) const {
   if (n_ == 0) return;
+  const FrictionSliding<dim> sl = sliding(x);
   const auto c = c_;
   const auto ml = ml_;
   const double s = s_, eh = eh_;
-  for_each_pair(x, [=](LO k, LO q, const PairDofs<dim>&, const auto& u, const auto& T) {
-    const Vec<dim> fk = ml(k) * friction_f1_over_y(u.norm(), eh) * (T * u);
-    for (int d = 0; d < dim; ++d) Kokkos::atomic_add(&f(q * dim + d), -s * c(k, 0) * fk(d));
-  });
+  Kokkos::parallel_for(
+      "friction_particle_forces", Kokkos::RangePolicy<ExecSpace>(0, n_), KOKKOS_LAMBDA(const LO k) {
+        Eigen::Matrix<double, dim, dim - 1> T;
+        Eigen::Matrix<double, dim - 1, 1> u;
+        sl(k, T, u);
+        const Vec<dim> fk = friction_pair_force<dim>(ml(k), eh, u, T);
+        const LO q = sl.pair(k, 0);
+        for (int d = 0; d < dim; ++d) Kokkos::atomic_add(&f(q * dim + d), -s * c(k, 0) * fk(d));
+      });
 }
 
 template class FrictionTerm<2>;

@@ -40,8 +40,6 @@ class FrictionTerm : public EnergyTerm<dim> {
   void add_particle_forces(ConstDofView x, DofView f) const;
 
  private:
-  template <class Body>
-  void for_each_pair(ConstDofView x, const Body& body) const;
   // Gradient (and with `hessian` the matrix) into the sink, one particle's
   // pairs at a time (as BarrierTerm::assemble_by_particle).
   void assemble_by_particle(ConstDofView x, const Sink<dim>& sink, bool hessian) const;
