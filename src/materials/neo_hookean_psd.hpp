@@ -17,53 +17,57 @@
 //   sum_k max(lambda_k, 0) vec(Q_k) vec(Q_k)^T, column-major vec as in
 //   StressDerivative. When every eigenvalue is >= 0 the exact tangent
 //   (NeoHookean::stress_derivative) is returned unchanged.
+// The SVD is one-sided Jacobi, and the scaling block's eigensolve (cyclic
+// Jacobi) runs only when A is not positive definite, which needs tension
+// (c < 0): no iterative tridiagonal solver on this path.
 // Precondition: det F > 0 (NaN otherwise, as stress_derivative).
-#include <Eigen/Eigenvalues>
-#include <Eigen/SVD>
 #include <cmath>
 
 #include "materials/neo_hookean.hpp"
+#include "materials/small_jacobi.hpp"
 
 namespace bfemp {
+
+// True when the symmetric d x d A is positive definite (every Cholesky pivot
+// > 0); then its projection is A itself and no eigensolve is needed. Under
+// compression (c > 0) the scaling block A = diag(mu + c / s_i^2) + lambda
+// (1/s)(1/s)^T always is.
+template <int dim>
+KOKKOS_INLINE_FUNCTION bool positive_definite(const Mat<dim>& A) {
+  Mat<dim> L = Mat<dim>::Zero();
+  for (int j = 0; j < dim; ++j) {
+    double d = A(j, j);
+    for (int k = 0; k < j; ++k) d -= L(j, k) * L(j, k);
+    if (!(d > 0.0)) return false;
+    L(j, j) = std::sqrt(d);
+    for (int i = j + 1; i < dim; ++i) {
+      double v = A(i, j);
+      for (int k = 0; k < j; ++k) v -= L(i, k) * L(j, k);
+      L(i, j) = v / L(j, j);
+    }
+  }
+  return true;
+}
 
 template <int dim>
 KOKKOS_INLINE_FUNCTION StressDerivative<dim> neo_hookean_stress_derivative_psd(const Mat<dim>& F,
                                                                                const LameParameters& p) {
   constexpr int n = dim * dim;
-  // SVD through the symmetric eigenproblem of F^T F = V diag(s^2) V^T
-  // (cheaper than JacobiSVD): s_min then carries a relative error of about
-  // eps (s_max / s_min)^2, so below s_min / s_max = 0.05 the one-sided Jacobi
-  // SVD is used instead. det V = 1 by a column flip; U = F V diag(1/s) then
-  // has det U = det F / (det V prod s) = 1.
-  const Eigen::SelfAdjointEigenSolver<Mat<dim>> ev(F.transpose() * F);
-  Mat<dim> U, V = ev.eigenvectors();
+  // One-sided Jacobi SVD (materials/small_jacobi.hpp): det U = det V = 1,
+  // singular values to relative accuracy, so near-inverted F need no other
+  // path.
+  Mat<dim> U, V;
   Vec<dim> s;
-  for (int i = 0; i < dim; ++i) s(i) = std::sqrt(std::max(ev.eigenvalues()(i), 0.0));
-  if (s(0) >= 0.05 * s(dim - 1)) {  // eigenvalues ascending
-    if (V.determinant() < 0) V.col(0) *= -1.0;
-    U = F * V * s.cwiseInverse().asDiagonal();
-  } else {
-    const Eigen::JacobiSVD<Mat<dim>> svd(F, Eigen::ComputeFullU | Eigen::ComputeFullV);
-    U = svd.matrixU();
-    V = svd.matrixV();
-    s = svd.singularValues();
-    if (U.determinant() < 0) {  // J > 0: det U and det V share their sign
-      U.col(dim - 1) *= -1.0;
-      V.col(dim - 1) *= -1.0;
-    }
-  }
+  jacobi_svd<dim>(F, U, s, V);
   const double logJ = std::log(F.determinant());
   const double c = p.mu - p.lambda * logJ;
   Mat<dim> A;
   for (int i = 0; i < dim; ++i)
     for (int j = 0; j < dim; ++j)
       A(i, j) = i == j ? p.mu + (c + p.lambda) / (s(i) * s(i)) : p.lambda / (s(i) * s(j));
-  // The iterative solver: the closed-form computeDirect loses eigenvector
-  // accuracy (1e-9) when singular values repeat.
-  const Eigen::SelfAdjointEigenSolver<Mat<dim>> es(A);
   constexpr int npairs = dim * (dim - 1) / 2;
   double flip[npairs], twist[npairs];
-  bool all_nonnegative = es.eigenvalues().minCoeff() >= 0.0;
+  bool flip_twist_nonnegative = true;
   {
     int k = 0;
     for (int i = 0; i < dim; ++i)
@@ -71,29 +75,48 @@ KOKKOS_INLINE_FUNCTION StressDerivative<dim> neo_hookean_stress_derivative_psd(c
         const double r = c / (s(i) * s(j));
         flip[k] = p.mu + r;
         twist[k] = p.mu - r;
-        all_nonnegative = all_nonnegative && flip[k] >= 0.0 && twist[k] >= 0.0;
+        flip_twist_nonnegative = flip_twist_nonnegative && flip[k] >= 0.0 && twist[k] >= 0.0;
       }
   }
-  if (all_nonnegative) return NeoHookean::stress_derivative<dim>(F, p);
+  // A_+: A itself when definite (always under compression), else clamped
+  // from its Jacobi eigenpairs.
+  Mat<dim> Ap = A;
+  bool scaling_nonnegative = positive_definite<dim>(A);
+  if (!scaling_nonnegative) {
+    Vec<dim> lam;
+    Mat<dim> W;
+    jacobi_symmetric_eigen<dim>(A, lam, W);
+    scaling_nonnegative = lam.minCoeff() >= 0.0;
+    Ap = W * lam.cwiseMax(0.0).asDiagonal() * W.transpose();
+  }
+  if (scaling_nonnegative && flip_twist_nonnegative) return NeoHookean::stress_derivative<dim>(F, p);
 
-  StressDerivative<dim> H = StressDerivative<dim>::Zero();
-  auto add_mode = [&](const Mat<dim>& Dhat, double lam) {  // Q = U Dhat V^T
-    if (!(lam > 0.0)) return;
-    const Mat<dim> Q = U * Dhat * V.transpose();
-    const Eigen::Map<const Eigen::Matrix<double, n, 1>> q(Q.data());
-    H.noalias() += lam * (q * q.transpose());
-  };
-  for (int k = 0; k < dim; ++k) add_mode(es.eigenvectors().col(k).asDiagonal().toDenseMatrix(), es.eigenvalues()(k));
-  const double h = 1.0 / std::sqrt(2.0);
+  // Scaling modes: S_i = vec(u_i v_i^T), their part of H is S A_+ S^T.
+  using Modes = Eigen::Matrix<double, n, dim>;
+  Modes S;
+  for (int i = 0; i < dim; ++i)
+    for (int col = 0; col < dim; ++col)
+      for (int row = 0; row < dim; ++row) S(row + dim * col, i) = U(row, i) * V(col, i);
+  const Modes SA = S.lazyProduct(Ap);
+  StressDerivative<dim> H;
+  H.noalias() = SA.lazyProduct(S.transpose());
+  // Flip and twist (i < j): with X = vec(u_i v_j^T), Y = vec(u_j v_i^T),
+  // f (X+Y)(X+Y)^T / 2 + t (X-Y)(X-Y)^T / 2 for the clamped f, t.
   int k = 0;
   for (int i = 0; i < dim; ++i)
     for (int j = i + 1; j < dim; ++j, ++k) {
-      Mat<dim> Df = Mat<dim>::Zero(), Dt = Mat<dim>::Zero();
-      Df(i, j) = Df(j, i) = h;
-      Dt(i, j) = h;
-      Dt(j, i) = -h;
-      add_mode(Df, flip[k]);
-      add_mode(Dt, twist[k]);
+      const double f = flip[k] > 0.0 ? 0.5 * flip[k] : 0.0;
+      const double t = twist[k] > 0.0 ? 0.5 * twist[k] : 0.0;
+      if (f == 0.0 && t == 0.0) continue;
+      Eigen::Matrix<double, n, 1> qf, qt;
+      for (int col = 0; col < dim; ++col)
+        for (int row = 0; row < dim; ++row) {
+          const double x = U(row, i) * V(col, j), y = U(row, j) * V(col, i);
+          qf(row + dim * col) = x + y;
+          qt(row + dim * col) = x - y;
+        }
+      if (f != 0.0) H.noalias() += f * (qf * qf.transpose());
+      if (t != 0.0) H.noalias() += t * (qt * qt.transpose());
     }
   return (0.5 * (H + H.transpose())).eval();
 }
