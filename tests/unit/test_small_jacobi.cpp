@@ -16,22 +16,13 @@
 #include <random>
 
 #include "materials/small_jacobi.hpp"
+#include "common/random_rotation.hpp"
 
 namespace {
 
 using namespace bfemp;
 
-template <int dim>
-Mat<dim> random_rotation(std::mt19937& rng) {
-  std::normal_distribution<double> g(0.0, 1.0);
-  Mat<dim> M;
-  for (int i = 0; i < dim; ++i)
-    for (int j = 0; j < dim; ++j) M(i, j) = g(rng);
-  Eigen::HouseholderQR<Mat<dim>> qr(M);
-  Mat<dim> Q = qr.householderQ();
-  if (Q.determinant() < 0) Q.col(0) *= -1.0;
-  return Q;
-}
+using bfemp::testing::random_rotation;
 
 template <int dim>
 void sorted(Vec<dim>& v) {
