@@ -18,9 +18,11 @@
 //   StressDerivative. When every eigenvalue is >= 0 the exact tangent
 //   (NeoHookean::stress_derivative) is returned unchanged.
 // The SVD is one-sided Jacobi, and the scaling block's eigensolve (cyclic
-// Jacobi) runs only when A is not positive definite, which needs tension
-// (c < 0): no iterative tridiagonal solver on this path.
-// Precondition: det F > 0 (NaN otherwise, as stress_derivative).
+// Jacobi) runs only when A is not positive definite, which with mu > 0 and
+// lambda >= 0 needs c < 0 (ln J > mu / lambda): no iterative tridiagonal
+// solver on this path.
+// Precondition: det F > 0 (the result is meaningless otherwise: NaN or a
+// clamped-away tangent, not an error).
 #include <cmath>
 
 #include "materials/neo_hookean.hpp"
@@ -28,34 +30,13 @@
 
 namespace bfemp {
 
-// True when the symmetric d x d A is positive definite (every Cholesky pivot
-// > 0); then its projection is A itself and no eigensolve is needed. Under
-// compression (c > 0) the scaling block A = diag(mu + c / s_i^2) + lambda
-// (1/s)(1/s)^T always is.
-template <int dim>
-KOKKOS_INLINE_FUNCTION bool positive_definite(const Mat<dim>& A) {
-  Mat<dim> L = Mat<dim>::Zero();
-  for (int j = 0; j < dim; ++j) {
-    double d = A(j, j);
-    for (int k = 0; k < j; ++k) d -= L(j, k) * L(j, k);
-    if (!(d > 0.0)) return false;
-    L(j, j) = std::sqrt(d);
-    for (int i = j + 1; i < dim; ++i) {
-      double v = A(i, j);
-      for (int k = 0; k < j; ++k) v -= L(i, k) * L(j, k);
-      L(i, j) = v / L(j, j);
-    }
-  }
-  return true;
-}
-
 template <int dim>
 KOKKOS_INLINE_FUNCTION StressDerivative<dim> neo_hookean_stress_derivative_psd(const Mat<dim>& F,
                                                                                const LameParameters& p) {
   constexpr int n = dim * dim;
   // One-sided Jacobi SVD (materials/small_jacobi.hpp): det U = det V = 1,
-  // singular values to relative accuracy, so near-inverted F need no other
-  // path.
+  // backward stable (errors of a few eps s_max, no F^T F), so near-inverted F
+  // need no other path.
   Mat<dim> U, V;
   Vec<dim> s;
   jacobi_svd<dim>(F, U, s, V);
@@ -78,10 +59,11 @@ KOKKOS_INLINE_FUNCTION StressDerivative<dim> neo_hookean_stress_derivative_psd(c
         flip_twist_nonnegative = flip_twist_nonnegative && flip[k] >= 0.0 && twist[k] >= 0.0;
       }
   }
-  // A_+: A itself when definite (always under compression), else clamped
-  // from its Jacobi eigenpairs.
+  // A_+: A itself when definite (with mu > 0, lambda >= 0: whenever c > 0,
+  // i.e. ln J < mu / lambda, any compression included), else clamped from
+  // its Jacobi eigenpairs.
   Mat<dim> Ap = A;
-  bool scaling_nonnegative = positive_definite<dim>(A);
+  bool scaling_nonnegative = cholesky_positive_definite<dim>(A);
   if (!scaling_nonnegative) {
     Vec<dim> lam;
     Mat<dim> W;

@@ -29,6 +29,9 @@
 
 namespace bfemp {
 
+// Cap on sweeps (never reached in the tests: at most 6).
+constexpr int max_jacobi_sweeps = 20;
+
 // tan of the Jacobi angle for zeta (see above), overflow-safe for huge zeta.
 KOKKOS_INLINE_FUNCTION double jacobi_tangent(double zeta) {
   const double az = std::fabs(zeta);
@@ -37,8 +40,9 @@ KOKKOS_INLINE_FUNCTION double jacobi_tangent(double zeta) {
 }
 
 // F = U diag(s) V^T, det U = det V = 1 when det F > 0 (see above).
+// Returns the sweeps made (the last one finds nothing to rotate; 3-5 in 3D).
 template <int dim>
-KOKKOS_INLINE_FUNCTION void jacobi_svd(const Mat<dim>& F, Mat<dim>& U, Vec<dim>& s, Mat<dim>& V) {
+KOKKOS_INLINE_FUNCTION int jacobi_svd(const Mat<dim>& F, Mat<dim>& U, Vec<dim>& s, Mat<dim>& V) {
   constexpr double tol = 1e-15;
   // Work on F / max|F_ij| (the squares below neither overflow nor underflow).
   double fmax = 0;
@@ -46,17 +50,20 @@ KOKKOS_INLINE_FUNCTION void jacobi_svd(const Mat<dim>& F, Mat<dim>& U, Vec<dim>&
     for (int i = 0; i < dim; ++i) fmax = std::fmax(fmax, std::fabs(F(i, j)));
   U = F / fmax;  // its columns become the f_i
   V.setIdentity();
-  // |f_i|^2, updated by each rotation: a <- a - t g, b <- b + t g (exact for
-  // the rotation that zeroes g; only the angles and the stopping test read them).
-  double norm2[dim];
-  for (int i = 0; i < dim; ++i) norm2[i] = U.col(i).squaredNorm();
-  for (int sweep = 0; sweep < 20; ++sweep) {
+  // a and b are recomputed for every pair: tracking them as a - t g, b + t g
+  // loses s_min^2 to cancellation once s_min / s_max nears 1e-8.
+  int sweep = 0;
+  while (sweep < max_jacobi_sweeps) {
+    ++sweep;
     bool rotated = false;
     for (int p = 0; p < dim - 1; ++p)
       for (int q = p + 1; q < dim; ++q) {
-        double g = 0;
-        for (int r = 0; r < dim; ++r) g += U(r, p) * U(r, q);
-        const double a = norm2[p], b = norm2[q];
+        double a = 0, b = 0, g = 0;
+        for (int r = 0; r < dim; ++r) {
+          a += U(r, p) * U(r, p);
+          b += U(r, q) * U(r, q);
+          g += U(r, p) * U(r, q);
+        }
         if (!(g * g > tol * tol * (a * b))) continue;
         rotated = true;
         // t = sign(zeta) / (|zeta| + sqrt(1 + zeta^2)) with zeta = (b - a) / (2 g),
@@ -65,8 +72,6 @@ KOKKOS_INLINE_FUNCTION void jacobi_svd(const Mat<dim>& F, Mat<dim>& U, Vec<dim>&
         const double tm = ag / (std::fabs(d) + std::sqrt(d * d + ag * ag));
         const double t = (d >= 0.0) == (g >= 0.0) ? tm : -tm;
         const double c = 1.0 / std::sqrt(1.0 + t * t), sn = c * t;
-        norm2[p] = a - t * g;
-        norm2[q] = b + t * g;
         for (int r = 0; r < dim; ++r) {
           const double up = U(r, p), uq = U(r, q);
           U(r, p) = c * up - sn * uq;
@@ -83,16 +88,19 @@ KOKKOS_INLINE_FUNCTION void jacobi_svd(const Mat<dim>& F, Mat<dim>& U, Vec<dim>&
     U.col(i) /= ni;
     s(i) = ni * fmax;
   }
+  return sweep;
 }
 
-// Symmetric A = W diag(lambda) W^T by cyclic Jacobi (A read as symmetric;
-// its upper triangle is used).
+// Symmetric A = W diag(lambda) W^T by cyclic Jacobi (precondition: A
+// exactly symmetric; both triangles are read). Returns the sweeps made.
 template <int dim>
-KOKKOS_INLINE_FUNCTION void jacobi_symmetric_eigen(const Mat<dim>& A_in, Vec<dim>& lambda, Mat<dim>& W) {
+KOKKOS_INLINE_FUNCTION int jacobi_symmetric_eigen(const Mat<dim>& A_in, Vec<dim>& lambda, Mat<dim>& W) {
   Mat<dim> A = A_in;
   W.setIdentity();
   const double scale = A.norm();
-  for (int sweep = 0; sweep < 20; ++sweep) {
+  int sweep = 0;
+  while (sweep < max_jacobi_sweeps) {
+    ++sweep;
     bool rotated = false;
     for (int p = 0; p < dim - 1; ++p)
       for (int q = p + 1; q < dim; ++q) {
@@ -122,6 +130,26 @@ KOKKOS_INLINE_FUNCTION void jacobi_symmetric_eigen(const Mat<dim>& A_in, Vec<dim
     if (!rotated) break;
   }
   for (int i = 0; i < dim; ++i) lambda(i) = A(i, i);
+  return sweep;
+}
+
+// True when the symmetric d x d A is positive definite: every pivot of its
+// Cholesky factorisation > 0 (a singular PSD A is not).
+template <int dim>
+KOKKOS_INLINE_FUNCTION bool cholesky_positive_definite(const Mat<dim>& A) {
+  Mat<dim> L = Mat<dim>::Zero();
+  for (int j = 0; j < dim; ++j) {
+    double d = A(j, j);
+    for (int k = 0; k < j; ++k) d -= L(j, k) * L(j, k);
+    if (!(d > 0.0)) return false;
+    L(j, j) = std::sqrt(d);
+    for (int i = j + 1; i < dim; ++i) {
+      double v = A(i, j);
+      for (int k = 0; k < j; ++k) v -= L(i, k) * L(j, k);
+      L(i, j) = v / L(j, j);
+    }
+  }
+  return true;
 }
 
 }  // namespace bfemp

@@ -95,3 +95,21 @@ TEST(NeoHookeanPsd, ProjectionActiveUnderCompression) {
   const StressDerivative<3> got = neo_hookean_stress_derivative_psd<3>(F, p);
   EXPECT_GT((exact - got).norm(), 1e-3 * exact.norm());
 }
+
+TEST(NeoHookeanPsd, IndefiniteScalingBlockIsProjected) {
+  // Guard that the scaling block's eigensolve path runs: at F = 5 I with
+  // nu = 0.49, A_ii = mu + (mu - 2 lambda ln 5) / 25 < 0, so A is not
+  // definite (checked here from the formula) and the result must still equal
+  // the eigensolver's projection.
+  const LameParameters p = lame_from_young(1e6, 0.49);
+  const double s = 5.0, c = p.mu - p.lambda * 3.0 * std::log(s);
+  Mat<3> A;
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) A(i, j) = i == j ? p.mu + (c + p.lambda) / (s * s) : p.lambda / (s * s);
+  ASSERT_FALSE(cholesky_positive_definite<3>(A));
+  std::mt19937 rng(21);
+  const Mat<3> F = random_rotation<3>(rng) * (s * Mat<3>::Identity()) * random_rotation<3>(rng);
+  EXPECT_LT(compare<3>(F, p), 1e-10);
+  const StressDerivative<3> exact = NeoHookean::stress_derivative<3>(F, p);
+  EXPECT_GT((exact - neo_hookean_stress_derivative_psd<3>(F, p)).norm(), 1e-3 * exact.norm());
+}

@@ -2,10 +2,11 @@
 // independent references:
 // - jacobi_svd: F = U diag(s) V^T to round-off, U and V orthogonal with
 //   det +1, and each singular value within 1e-14 s_max of the ones F was
-//   built from (backward stable), also at s_min / s_max = 1e-8, where an
+//   built from (backward stable), also at s_min / s_max = 1e-8 .. 1e-12, where an
 //   F^T F eigensolve loses every digit of s_min; repeated singular values, a diagonal
-//   F (no rotation needed), a permutation-like F (rotations of 90 degrees),
-//   and scales from 1e-150 to 1e150.
+//   F and a permuted one (columns already orthogonal: no rotation), equal
+//   column norms (the 45-degree rotation), scales from 1e-150 to 1e150, and
+//   at most 6 sweeps everywhere.
 // - jacobi_symmetric_eigen: A = W diag(lambda) W^T, W orthogonal, and the
 //   eigenvalues equal to long-double characteristic roots of known spectra,
 //   indefinite and with repeated eigenvalues.
@@ -13,6 +14,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <Eigen/SVD>
 #include <random>
 
 #include "materials/small_jacobi.hpp"
@@ -34,7 +36,10 @@ template <int dim>
 void check_svd(const Mat<dim>& F, Vec<dim> s_true, const char* what) {
   Mat<dim> U, V;
   Vec<dim> s;
-  jacobi_svd<dim>(F, U, s, V);
+  const int sweeps = jacobi_svd<dim>(F, U, s, V);
+  // Quadratic convergence: a slow variant (a wrong angle, a stale norm)
+  // would still end orthogonal, at the cap.
+  EXPECT_LE(sweeps, 6) << what;
   const Mat<dim> I = Mat<dim>::Identity();
   EXPECT_LT((U.transpose() * U - I).norm(), 1e-14) << what;
   EXPECT_LT((V.transpose() * V - I).norm(), 1e-14) << what;
@@ -57,7 +62,7 @@ void svd_families() {
     for (int i = 0; i < dim; ++i) s(i) = std::exp(logu(rng));
     if (t % 5 == 1) s(1) = s(0);               // two equal
     if (t % 5 == 2) s.setConstant(s(0));       // all equal
-    if (t % 5 == 3) s(dim - 1) = 1e-8 * s(0);  // near-inverted: relative accuracy
+    if (t % 5 == 3) s(dim - 1) = std::pow(10.0, -8 - t % 3 * 2) * s(0);  // near-inverted: 1e-8, 1e-10, 1e-12
     const Mat<dim> F = random_rotation<dim>(rng) * s.asDiagonal() * random_rotation<dim>(rng);
     check_svd<dim>(F, s, "random");
   }
@@ -69,6 +74,12 @@ void svd_families() {
   for (int i = 0; i < dim; ++i) P((i + 1) % dim, i) = s(i);
   if (P.determinant() < 0) P.col(0) *= -1.0;
   check_svd<dim>(P, s, "permutation");
+  // Equal column norms, not orthogonal: zeta = 0, the 45-degree rotation.
+  Mat<dim> E = Mat<dim>::Identity();
+  E(0, 1) = 0.6;
+  E(1, 1) = 0.8;
+  const Eigen::JacobiSVD<Mat<dim>> ref(E);
+  check_svd<dim>(E, ref.singularValues(), "45 degrees");
   // Extreme scales.
   for (double scale : {1e-150, 1e150}) {
     const Vec<dim> ss = scale * s;
@@ -94,7 +105,7 @@ void eigen_families() {
     const Mat<dim> A = R * lam.asDiagonal() * R.transpose();
     Vec<dim> got;
     Mat<dim> W;
-    jacobi_symmetric_eigen<dim>(A, got, W);
+    EXPECT_LE(jacobi_symmetric_eigen<dim>(A, got, W), 6);
     EXPECT_LT((W.transpose() * W - Mat<dim>::Identity()).norm(), 1e-14);
     EXPECT_LT((W * got.asDiagonal() * W.transpose() - A).norm(), 1e-14 * A.norm() + 1e-300);
     sorted<dim>(got);
@@ -120,6 +131,20 @@ TEST(SmallJacobi, TangentOverflowSafe) {
     EXPECT_NEAR(t * t + 2 * z * t - 1.0, 0.0, 1e-15 * (1 + std::fabs(z * t))) << z;
     EXPECT_LE(std::fabs(t), 1.0) << z;
   }
+}
+
+TEST(SmallJacobi, CholeskyDefiniteness) {
+  EXPECT_TRUE(cholesky_positive_definite<3>(Mat<3>::Identity()));
+  Mat<3> A = Mat<3>::Identity();
+  A(2, 2) = 0.0;  // PSD, singular: not definite
+  EXPECT_FALSE(cholesky_positive_definite<3>(A));
+  A(2, 2) = -1e-12;
+  EXPECT_FALSE(cholesky_positive_definite<3>(A));
+  Mat<2> B;
+  B << 1.0, 2.0, 2.0, 1.0;  // eigenvalues 3, -1
+  EXPECT_FALSE(cholesky_positive_definite<2>(B));
+  B(0, 1) = B(1, 0) = 0.9;
+  EXPECT_TRUE(cholesky_positive_definite<2>(B));
 }
 
 }  // namespace
