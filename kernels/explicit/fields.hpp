@@ -1,17 +1,18 @@
 #pragma once
 // Plain-data views of the explicit multimaterial MPM (paper 001 §3.2) and the
 // kernels shared by the stepper and the tests: particle binning by cell, the
-// per-material grid operator S^{+alpha} S of XPIC(m) and the v*^alpha task of
-// Eqs. 42-44.
+// particles' stencils of a step, the per-material grid operator S^{+alpha} S
+// of XPIC(m) and the v*^alpha task of Eqs. 42-44.
 //
 // Grid fields are per (node, material class): slot = node * M + a for M
 // classes; vector fields hold dim doubles per slot (slot * dim + c). Units:
 // mass kg (kg/m in 2D plane strain), momentum kg m/s, velocity m/s.
 #include <Kokkos_Core.hpp>
-#include <Kokkos_ScatterView.hpp>
+#include <Kokkos_UniqueToken.hpp>
 
 #include "core/types.hpp"
 #include "kernels/mpm/grid.hpp"
+#include "kernels/small_loops.hpp"
 
 namespace bfemp::xmpm {
 
@@ -28,7 +29,47 @@ struct XParticles {
   std::size_t size() const { return mass.extent(0); }
 };
 
-using Scatter = Kokkos::Experimental::ScatterView<double*, Kokkos::LayoutRight, ExecSpace>;
+// A grid field summed from a particle loop without atomics: one private copy
+// per thread (rows of `copies`), zeroed by reset() before the loop, written
+// through access() inside it, and summed into the field in thread order by
+// contribute() after it: field(i) = copies(0, i) + copies(1, i) + ... (the
+// field's old values are overwritten, so it needs no zeroing). The same sums
+// in the same order as a duplicated Kokkos::ScatterView contributed into a
+// zeroed field, with reset and contribute as short loops (small_loops.hpp)
+// instead of two parallel launches each.
+struct Scatter {
+  Kokkos::Experimental::UniqueToken<ExecSpace> token;  // before copies: sizes them
+  Kokkos::View<double**, Kokkos::LayoutRight, MemSpace> copies;  // (threads, n)
+  Kokkos::View<double*, MemSpace> field;
+
+  Scatter() = default;
+  explicit Scatter(Kokkos::View<double*, MemSpace> f)
+      : token(),
+        copies(Kokkos::view_alloc("xmpm_scatter", Kokkos::WithoutInitializing), token.size(), f.extent(0)),
+        field(f) {}
+
+  void reset() const { small_fill(copies, 0.0); }
+
+  // Within a particle loop on ExecSpace: this thread's copy.
+  struct Access {
+    double* row;
+    KOKKOS_INLINE_FUNCTION double& operator()(LO i) const { return row[i]; }
+  };
+  KOKKOS_INLINE_FUNCTION Access access() const { return Access{&copies(token.acquire(), 0)}; }
+  // (UniqueToken<OpenMP>::acquire is the thread's id and release a no-op; this loop-scoped use relies on it.)
+
+  void contribute() const {
+    const auto c = copies;
+    const auto f = field;
+    const LO nt = static_cast<LO>(copies.extent(0));
+    small_for(
+        "xmpm_scatter_sum", static_cast<long>(field.extent(0)), KOKKOS_LAMBDA(const LO i) {
+          double s = 0.0;
+          for (LO t = 0; t < nt; ++t) s += c(t, i);
+          f(i) = s;
+        });
+  }
+};
 
 template <int dim>
 KOKKOS_INLINE_FUNCTION Vec<dim> pos(const XParticles<dim>& p, LO q) {
@@ -73,25 +114,27 @@ void bin_particles(const GridSpec<dim>& g, const XParticles<dim>& p, CellBins& b
   }
   if (static_cast<LO>(bins.sorted.extent(0)) != np) bins.sorted = Kokkos::View<LO*, MemSpace>("xmpm_sorted", np);
   auto start = bins.start, fill = bins.fill, sorted = bins.sorted;
-  Kokkos::deep_copy(fill, 0);
-  Kokkos::parallel_for(
-      "xmpm_bin_count", Kokkos::RangePolicy<ExecSpace>(0, np),
+  small_fill(fill, 0);
+  small_for(
+      "xmpm_bin_count", np,
       KOKKOS_LAMBDA(const LO q) { Kokkos::atomic_increment(&fill(cell_of(g, pos(p, q)))); });
-  Kokkos::parallel_scan(
-      "xmpm_bin_scan", Kokkos::RangePolicy<ExecSpace>(0, nc + 1),
+  LO total = 0;
+  small_scan(
+      "xmpm_bin_scan", nc + 1,
       KOKKOS_LAMBDA(const LO c, LO& off, const bool final) {
         const LO n = c < nc ? fill(c) : 0;
         if (final) start(c) = off;
         off += n;
-      });
-  Kokkos::deep_copy(fill, 0);
-  Kokkos::parallel_for(
-      "xmpm_bin_fill", Kokkos::RangePolicy<ExecSpace>(0, np), KOKKOS_LAMBDA(const LO q) {
+      },
+      total);
+  small_fill(fill, 0);
+  small_for(
+      "xmpm_bin_fill", np, KOKKOS_LAMBDA(const LO q) {
         const LO c = cell_of(g, pos(p, q));
         sorted(start(c) + Kokkos::atomic_fetch_add(&fill(c), 1)) = q;
       });
-  Kokkos::parallel_for(
-      "xmpm_bin_order", Kokkos::RangePolicy<ExecSpace>(0, nc), KOKKOS_LAMBDA(const LO c) {
+  small_for(
+      "xmpm_bin_order", nc, KOKKOS_LAMBDA(const LO c) {
         for (LO i = start(c) + 1; i < start(c + 1); ++i) {  // insertion sort: a few particles per cell
           const LO v = sorted(i);
           LO j = i - 1;
@@ -111,55 +154,70 @@ struct GridConstraints {
   Kokkos::View<double*, MemSpace> value;
 };
 
-// out^alpha = (S^{+alpha} S) in^alpha for two fields at once (Eq. 43-44):
-// (S in)_p = sum_i S_pi in_i^{cls p}, out_i^alpha = sum_{p in alpha} S_pi m_p (S in)_p / m_i^alpha
-// (zero where m_i^alpha = 0). acc: scatter over a scratch View of the same size.
+// Each particle's shape-function stencil (base node, per-axis weights and
+// derivatives), computed once per step: positions do not move between P2G
+// and G2P, so every kernel of the step (P2G, stress, forces, the XPIC
+// sweeps, G2P) reads the same stencil instead of evaluating it again.
+// Allocates only when the particle count changes.
 template <int dim, class Shape>
-void sps_apply2(const GridSpec<dim>& g, int M, const XParticles<dim>& p, Kokkos::View<const double*, MemSpace> gmass,
-                Kokkos::View<const double*, MemSpace> in1, Kokkos::View<const double*, MemSpace> in2,
-                Kokkos::View<double*, MemSpace> out1, Kokkos::View<double*, MemSpace> out2, Scatter& acc1,
-                Scatter& acc2) {
+using StencilView = Kokkos::View<typename Shape::template Stencil<dim>*, MemSpace>;
+
+template <int dim, class Shape>
+void compute_stencils(const GridSpec<dim>& g, const XParticles<dim>& p, StencilView<dim, Shape>& st) {
+  if (st.extent(0) != p.size()) st = StencilView<dim, Shape>(Kokkos::view_alloc("xmpm_stencils", Kokkos::WithoutInitializing), p.size());
+  const auto out = st;
+  Kokkos::parallel_for(
+      "xmpm_stencils", Kokkos::RangePolicy<ExecSpace>(0, p.size()),
+      KOKKOS_LAMBDA(const LO q) { out(q) = Shape::template stencil<dim>(g, pos(p, q), p.lp(q)); });
+}
+
+// The sums of (S^{+alpha} S) in^alpha for two fields at once (Eq. 43-44),
+// before the division by the node mass:
+// (S in)_p = sum_i S_pi in_i^{cls p}, sum1_i^alpha = sum_{p in alpha} S_pi m_p (S in)_p;
+// out_i^alpha = sum_i^alpha / m_i^alpha (zero where m_i^alpha = 0) is left to
+// the caller (xpic_vstar fuses it with the series update). acc1, acc2: the
+// scatters onto out1, out2. second = false: the first field only (out2 untouched).
+template <int dim, class Shape>
+void sps_sums2(const GridSpec<dim>& g, int M, const XParticles<dim>& p,
+               Kokkos::View<const typename Shape::template Stencil<dim>*, MemSpace> sts,
+               Kokkos::View<const double*, MemSpace> in1, Kokkos::View<const double*, MemSpace> in2,
+               const Scatter& acc1, const Scatter& acc2, bool second = true) {
   using St = typename Shape::template Stencil<dim>;
-  Kokkos::deep_copy(out1, 0.0);
-  Kokkos::deep_copy(out2, 0.0);
   acc1.reset();
-  acc2.reset();
+  if (second) acc2.reset();
   auto a1 = acc1, a2 = acc2;
   Kokkos::parallel_for(
       "xmpm_sps", Kokkos::RangePolicy<ExecSpace>(0, p.size()), KOKKOS_LAMBDA(const LO q) {
-        const St st = Shape::template stencil<dim>(g, pos(p, q), p.lp(q));
+        const St& st = sts(q);
         const int a = p.cls(q);
-        double v1[dim] = {}, v2[dim] = {};
+        // weights and slots in registers: the scatter's stores may alias the stencil's memory
+        double w[St::size];
+        LO sl[St::size];
         for (int k = 0; k < St::size; ++k) {
-          const double w = st.weight(k);
-          const LO s = (st.node(g, k) * M + a) * dim;
-          for (int c = 0; c < dim; ++c) {
-            v1[c] += w * in1(s + c);
-            v2[c] += w * in2(s + c);
-          }
+          w[k] = st.weight(k);
+          sl[k] = (st.node(g, k) * M + a) * dim;
         }
+        const double mq = p.mass(q);
+        double v1[dim] = {};
+        for (int k = 0; k < St::size; ++k)
+          for (int c = 0; c < dim; ++c) v1[c] += w[k] * in1(sl[k] + c);
         auto o1 = a1.access();
+        for (int k = 0; k < St::size; ++k) {
+          const double wm = w[k] * mq;
+          for (int c = 0; c < dim; ++c) o1(sl[k] + c) += wm * v1[c];
+        }
+        if (!second) return;
+        double v2[dim] = {};
+        for (int k = 0; k < St::size; ++k)
+          for (int c = 0; c < dim; ++c) v2[c] += w[k] * in2(sl[k] + c);
         auto o2 = a2.access();
         for (int k = 0; k < St::size; ++k) {
-          const double wm = st.weight(k) * p.mass(q);
-          const LO s = (st.node(g, k) * M + a) * dim;
-          for (int c = 0; c < dim; ++c) {
-            o1(s + c) += wm * v1[c];
-            o2(s + c) += wm * v2[c];
-          }
+          const double wm = w[k] * mq;
+          for (int c = 0; c < dim; ++c) o2(sl[k] + c) += wm * v2[c];
         }
       });
-  Kokkos::Experimental::contribute(out1, acc1);
-  Kokkos::Experimental::contribute(out2, acc2);
-  const LO nslot = static_cast<LO>(gmass.extent(0));
-  Kokkos::parallel_for(
-      "xmpm_sps_divide", Kokkos::RangePolicy<ExecSpace>(0, nslot), KOKKOS_LAMBDA(const LO s) {
-        const double m = gmass(s);
-        for (int c = 0; c < dim; ++c) {
-          out1(s * dim + c) = m > 0 ? out1(s * dim + c) / m : 0.0;
-          out2(s * dim + c) = m > 0 ? out2(s * dim + c) / m : 0.0;
-        }
-      });
+  acc1.contribute();
+  if (second) acc2.contribute();
 }
 
 // Scratch of the XPIC task (sized like a vector grid field).
@@ -183,32 +241,44 @@ struct XpicScratch {
 //   v* = sum_{k=2}^m (-1)^k (v*_k + (m-1)/m Dv*_{k-1}).
 // Constrained grid components keep their own value scaled by the same factors
 // (a prescribed velocity field is reproduced: P V = S v_bc). m >= 1 (m = 1: v* = 0).
+// sts: the particles' stencils at their current positions (compute_stencils).
 template <int dim, class Shape>
-void xpic_vstar(const GridSpec<dim>& g, int M, const XParticles<dim>& p, Kokkos::View<const double*, MemSpace> gmass,
-                Kokkos::View<const double*, MemSpace> v1, Kokkos::View<const double*, MemSpace> dv1, int m,
-                const GridConstraints& bc, Kokkos::View<double*, MemSpace> vstar, XpicScratch& s) {
+void xpic_vstar(const GridSpec<dim>& g, int M, const XParticles<dim>& p,
+                Kokkos::View<const typename Shape::template Stencil<dim>*, MemSpace> sts,
+                Kokkos::View<const double*, MemSpace> gmass, Kokkos::View<const double*, MemSpace> v1,
+                Kokkos::View<const double*, MemSpace> dv1, int m, const GridConstraints& bc,
+                Kokkos::View<double*, MemSpace> vstar, XpicScratch& s) {
   s.ensure(v1.extent(0));
-  Kokkos::deep_copy(vstar, 0.0);
-  Kokkos::deep_copy(s.vk, v1);
-  Kokkos::deep_copy(s.dvk, dv1);
   const LO n = static_cast<LO>(v1.extent(0));
+  {
+    auto vs = vstar, vk = s.vk, dvk = s.dvk;
+    small_for(
+        "xpic_start", n, KOKKOS_LAMBDA(const LO i) {
+          vs(i) = 0.0;
+          vk(i) = v1(i);
+          dvk(i) = dv1(i);
+        });
+  }
   for (int k = 2; k <= m; ++k) {
-    sps_apply2<dim, Shape>(g, M, p, gmass, s.vk, s.dvk, s.vk1, s.dvk1, s.acc1, s.acc2);
+    // Dv*_k is needed up to k = m - 1 (its factor (m - k)/k is 0 at k = m): the last sweep is v's alone.
+    const bool dv_sweep = k < m;
+    sps_sums2<dim, Shape>(g, M, p, sts, s.vk, s.dvk, s.acc1, s.acc2, dv_sweep);
     const double fv = double(m + 1 - k) / k, fd = double(m - k) / k, fm = double(m - 1) / m;
     const double sign = k % 2 == 0 ? 1.0 : -1.0;
     auto vk = s.vk, dvk = s.dvk, vk1 = s.vk1, dvk1 = s.dvk1;
     auto flag = bc.flag;
     const bool has_bc = flag.extent(0) > 0;
-    Kokkos::parallel_for(
-        "xpic_step", Kokkos::RangePolicy<ExecSpace>(0, n), KOKKOS_LAMBDA(const LO i) {
+    small_for(
+        "xpic_step", n, KOKKOS_LAMBDA(const LO i) {
           const LO node = i / (dim * M), c = i % dim;
           double nv, nd;
           if (has_bc && flag(node * dim + c)) {
             nv = fv * vk(i);
             nd = fd * dvk(i);
           } else {
-            nv = fv * vk1(i);
-            nd = fd * dvk1(i);
+            const double mi = gmass(i / dim);  // S+S in = sums / m_i^alpha
+            nv = fv * (mi > 0 ? vk1(i) / mi : 0.0);
+            nd = dv_sweep ? fd * (mi > 0 ? dvk1(i) / mi : 0.0) : 0.0;  // fd = 0 at k = m
           }
           vstar(i) += sign * (nv + fm * dvk(i));
           vk(i) = nv;

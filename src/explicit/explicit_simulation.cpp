@@ -7,8 +7,10 @@
 #include <cmath>
 #include <sstream>
 #include <stdexcept>
+#include <type_traits>
 
 #include "kernels/explicit/shape_functions.hpp"
+#include "kernels/small_loops.hpp"
 #include "materials/linear_elastic.hpp"
 #include "materials/neo_hookean.hpp"
 
@@ -85,6 +87,8 @@ struct ExplicitSimulation<dim>::Impl {
   Kokkos::View<LawParams*, MemSpace> laws;
   Kokkos::View<LevelSet*, MemSpace> lsets;
   CellBins bins;
+  // the particles' stencils of the step (both shapes use the 3-per-axis tensor stencil)
+  Kokkos::View<TensorStencil<dim, 3>*, MemSpace> stencils;
   // grid fields (slot = node * M + a)
   DView gm, p0, pc, v, v0, dv, f, vp, grad, xm, vstar, normal, sep, zero;
   Scatter s_m, s_p, s_g, s_x, s_f;
@@ -222,8 +226,8 @@ struct ExplicitSimulation<dim>::Impl {
     const auto ls = lsets;
     const int nls = static_cast<int>(lsets.extent(0));
     const auto gg = g;
-    Kokkos::parallel_for(
-        "xmpm_constraints", Kokkos::RangePolicy<ExecSpace>(0, nn), KOKKOS_LAMBDA(const LO n) {
+    small_for(
+        "xmpm_constraints", nn, KOKKOS_LAMBDA(const LO n) {
           for (int c = 0; c < dim; ++c) {
             flag(n * dim + c) = 0;
             val(n * dim + c) = 0;
@@ -254,8 +258,8 @@ struct ExplicitSimulation<dim>::Impl {
     const auto flag = bc.flag;
     const auto val = bc.value;
     const int MM = M;
-    Kokkos::parallel_for(
-        "xmpm_velocity", Kokkos::RangePolicy<ExecSpace>(0, nn * M), KOKKOS_LAMBDA(const LO s) {
+    small_for(
+        "xmpm_velocity", nn * M, KOKKOS_LAMBDA(const LO s) {
           const LO n = s / MM;
           for (int c = 0; c < dim; ++c) {
             double x = m(s) > 0 ? mom(s * dim + c) / m(s) : 0.0;
@@ -271,8 +275,8 @@ struct ExplicitSimulation<dim>::Impl {
     const auto flag = bc.flag;
     const auto val = bc.value;
     const int MM = M;
-    Kokkos::parallel_for(
-        "xmpm_constrain", Kokkos::RangePolicy<ExecSpace>(0, nn * M), KOKKOS_LAMBDA(const LO s) {
+    small_for(
+        "xmpm_constrain", nn * M, KOKKOS_LAMBDA(const LO s) {
           const LO n = s / MM;
           for (int c = 0; c < dim; ++c)
             if (flag(n * dim + c)) mom(s * dim + c) = m(s) * val(n * dim + c);
@@ -287,6 +291,7 @@ template <int dim, class Shape>
 struct StepKernels {
   using St = typename Shape::template Stencil<dim>;
   using Impl = typename ExplicitSimulation<dim>::Impl;
+  static_assert(std::is_same_v<St, TensorStencil<dim, 3>>, "Impl::stencils holds 3-per-axis tensor stencils");
 
   static void p2g(Impl& s) {
     const auto p = s.p;
@@ -294,23 +299,20 @@ struct StepKernels {
     const int M = s.M;
     const bool ag = s.setup.normals == XNormals::AG;
     const bool cp = ag && s.setup.separation == XSeparation::CP;
-    Kokkos::deep_copy(s.gm, 0.0);
-    Kokkos::deep_copy(s.p0, 0.0);
     s.s_m.reset();
     s.s_p.reset();
     auto sm = s.s_m, sp = s.s_p, sg = s.s_g, sx = s.s_x;
     if (ag) {
-      Kokkos::deep_copy(s.grad, 0.0);
       s.s_g.reset();
     }
     if (cp) {
-      Kokkos::deep_copy(s.xm, 0.0);
       s.s_x.reset();
     }
+    const auto sts = s.stencils;
     Kokkos::parallel_for(
         "xmpm_p2g", Kokkos::RangePolicy<ExecSpace>(0, p.size()), KOKKOS_LAMBDA(const LO q) {
           const Vec<dim> x = pos(p, q);
-          const St st = Shape::template stencil<dim>(g, x, p.lp(q));
+          const St& st = sts(q);
           const int a = p.cls(q);
           const double mq = p.mass(q);
           auto am = sm.access();
@@ -340,10 +342,10 @@ struct StepKernels {
             }
           }
         });
-    Kokkos::Experimental::contribute(s.gm, s.s_m);
-    Kokkos::Experimental::contribute(s.p0, s.s_p);
-    if (ag) Kokkos::Experimental::contribute(s.grad, s.s_g);
-    if (cp) Kokkos::Experimental::contribute(s.xm, s.s_x);
+    s.s_m.contribute();
+    s.s_p.contribute();
+    if (ag) s.s_g.contribute();
+    if (cp) s.s_x.contribute();
   }
 
   // Contact nodes (>= 2 classes) into s.cnodes; returns (count, 3+ count).
@@ -353,8 +355,8 @@ struct StepKernels {
     auto list = s.cnodes;
     LO count = 0, multi = 0;
     if (M < 2) return {0, 0};
-    Kokkos::parallel_scan(
-        "xmpm_contact_nodes", Kokkos::RangePolicy<ExecSpace>(0, s.nn),
+    small_scan(
+        "xmpm_contact_nodes", s.nn,
         KOKKOS_LAMBDA(const LO n, LO& off, const bool final) {
           int present[ExplicitSimulation<dim>::kMaxClasses];
           const int k = present_classes(gm, n, M, present);
@@ -364,8 +366,8 @@ struct StepKernels {
           }
         },
         count);
-    Kokkos::parallel_reduce(
-        "xmpm_multi_nodes", Kokkos::RangePolicy<ExecSpace>(0, count),
+    small_reduce(
+        "xmpm_multi_nodes", count,
         KOKKOS_LAMBDA(const LO i, LO& acc) {
           int present[ExplicitSimulation<dim>::kMaxClasses];
           acc += present_classes(gm, list(i), M, present) >= 3;
@@ -487,10 +489,10 @@ struct StepKernels {
     const auto list = s.cnodes;
     const int M = s.M;
     const bool store = dvout.extent(0) > 0;
-    if (store) Kokkos::deep_copy(dvout, 0.0);
+    if (store) small_fill(dvout, 0.0);
     LO active = 0;
-    Kokkos::parallel_reduce(
-        "xmpm_contact_pass", Kokkos::RangePolicy<ExecSpace>(0, count),
+    small_reduce(
+        "xmpm_contact_pass", count,
         KOKKOS_LAMBDA(const LO i, LO& acc) {
           const LO node = list(i);
           int present[ExplicitSimulation<dim>::kMaxClasses];
@@ -573,9 +575,10 @@ struct StepKernels {
     const auto g = s.g;
     const auto mt = s.mats;
     const int M = s.M;
+    const auto sts = s.stencils;
     Kokkos::parallel_for(
         "xmpm_stress", Kokkos::RangePolicy<ExecSpace>(0, p.size()), KOKKOS_LAMBDA(const LO q) {
-          const St st = Shape::template stencil<dim>(g, pos(p, q), p.lp(q));
+          const St& st = sts(q);
           const int a = p.cls(q);
           Mat<dim> L = Mat<dim>::Zero();
           for (int k = 0; k < St::size; ++k) {
@@ -604,12 +607,12 @@ struct StepKernels {
       for (int d = 0; d < dim; ++d) x(d) = grav[d];
       return x;
     }();
-    Kokkos::deep_copy(s.f, 0.0);
     s.s_f.reset();
     auto sf = s.s_f;
+    const auto sts = s.stencils;
     Kokkos::parallel_for(
         "xmpm_forces", Kokkos::RangePolicy<ExecSpace>(0, p.size()), KOKKOS_LAMBDA(const LO q) {
-          const St st = Shape::template stencil<dim>(g, pos(p, q), p.lp(q));
+          const St& st = sts(q);
           const int a = p.cls(q);
           const double V = getF(p, q).determinant() * p.volume0(q);
           Mat<dim> sig;
@@ -622,7 +625,7 @@ struct StepKernels {
             for (int c = 0; c < dim; ++c) af(slot * dim + c) += fi(c);
           }
         });
-    Kokkos::Experimental::contribute(s.f, s.s_f);
+    s.s_f.contribute();
   }
 
   static void provisional(Impl& s, double dt) {
@@ -630,8 +633,8 @@ struct StepKernels {
     const auto v = s.v, f = s.f;
     auto mom = s.vp;
     const int M = s.M;
-    Kokkos::parallel_for(
-        "xmpm_provisional", Kokkos::RangePolicy<ExecSpace>(0, s.nn * M), KOKKOS_LAMBDA(const LO sl) {
+    small_for(
+        "xmpm_provisional", s.nn * M, KOKKOS_LAMBDA(const LO sl) {
           for (int c = 0; c < dim; ++c) mom(sl * dim + c) = gm(sl) * v(sl * dim + c) + f(sl * dim + c) * dt;
         });
   }
@@ -650,12 +653,13 @@ struct StepKernels {
       dv1 = s.zero;
     }
     if (xpic)
-      xpic_vstar<dim, Shape>(g, M, p, s.gm, v1, dv1, m, s.bc, s.vstar, s.xpic);
+      xpic_vstar<dim, Shape>(g, M, p, s.stencils, s.gm, v1, dv1, m, s.bc, s.vstar, s.xpic);
     const auto vs = s.vstar;
     const auto vone = v1;
+    const auto sts = s.stencils;
     Kokkos::parallel_for(
         "xmpm_g2p", Kokkos::RangePolicy<ExecSpace>(0, p.size()), KOKKOS_LAMBDA(const LO q) {
-          const St st = Shape::template stencil<dim>(g, pos(p, q), p.lp(q));
+          const St& st = sts(q);
           const int a = p.cls(q);
           double Svp[dim] = {}, Sa[dim] = {}, Sv1[dim] = {}, Svs[dim] = {};
           for (int k = 0; k < St::size; ++k) {
@@ -697,6 +701,7 @@ struct StepKernels {
     if (s.setup.fixed_dt > 0 && dt > limit) s.over_limit++;
     r.dt_limit = limit;
     bin_particles(s.g, s.p, s.bins);
+    compute_stencils<dim, Shape>(s.g, s.p, s.stencils);
     s.build_constraints(s.time);
     p2g(s);
     Kokkos::fence();
@@ -706,9 +711,9 @@ struct StepKernels {
     r.contact_nodes = count;
     r.multi_nodes = multi;
     if (count > 0) normals(s, count);
-    Kokkos::deep_copy(s.pc, s.p0);
+    small_copy(s.pc, s.p0);
     if (count > 0 && s.setup.contact_passes == 2) pass(s, count, s.pc, s.dv);
-    else Kokkos::deep_copy(s.dv, 0.0);
+    else small_fill(s.dv, 0.0);
     Kokkos::fence();
     r.contact_s += t.seconds();
     t.reset();
@@ -745,11 +750,11 @@ struct StepKernels {
       const auto it = s.lr_iters;
       int mx = 0;
       long sum = 0;
-      Kokkos::parallel_reduce(
-          "xmpm_lr_stats", Kokkos::RangePolicy<ExecSpace>(0, count),
+      small_reduce(
+          "xmpm_lr_stats", count,
           KOKKOS_LAMBDA(const LO i, long& a) { a += it(i); }, sum);
-      Kokkos::parallel_reduce(
-          "xmpm_lr_max", Kokkos::RangePolicy<ExecSpace>(0, count),
+      small_reduce(
+          "xmpm_lr_max", count,
           KOKKOS_LAMBDA(const LO i, int& a) {
             if (it(i) > a) a = it(i);
           },

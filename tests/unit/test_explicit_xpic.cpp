@@ -135,7 +135,9 @@ void check(int M, int order, bool with_dv, unsigned seed) {
   Kokkos::deep_copy(dv1, hdv);
   XpicScratch scratch;
   GridConstraints none;  // no constrained nodes
-  xpic_vstar<2, UGimp>(t.g, M, t.p, t.gm, v1, dv1, order, none, vstar, scratch);
+  StencilView<2, UGimp> sts;
+  compute_stencils<2, UGimp>(t.g, t.p, sts);
+  xpic_vstar<2, UGimp>(t.g, M, t.p, sts, t.gm, v1, dv1, order, none, vstar, scratch);
   auto hvs = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), vstar);
   double worst = 0, scale = 0;
   for (int a = 0; a < M; ++a) {
