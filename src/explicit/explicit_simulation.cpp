@@ -83,6 +83,10 @@ struct ExplicitSimulation<dim>::Impl {
   double time = 0;
   long step = 0;
   long over_limit = 0;
+  // max_p (c_p + |v_p|) of the current state when known (>= 0): the step's
+  // closing reduction computes it with the diagnostics, so the next step's
+  // CFL limit needs no pass of its own; -1 after construction and restore.
+  double known_cmax = -1;
   Kokkos::View<XMaterial*, MemSpace> mats;
   Kokkos::View<LawParams*, MemSpace> laws;
   Kokkos::View<LevelSet*, MemSpace> lsets;
@@ -178,16 +182,19 @@ struct ExplicitSimulation<dim>::Impl {
           if (!in && q > acc) acc = q;
         },
         Kokkos::Max<LO>(bad));
-    if (bad >= 0) {
-      auto xh = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), p.x);
-      std::ostringstream m;
-      m << "explicit MPM: particle " << bad << " at (";
-      for (int d = 0; d < dim; ++d) m << (d ? ", " : "") << xh(bad, d);
-      m << ") " << when << " (step " << step
-        << ") has a shape-function stencil outside the grid; enlarge MPM/domain min / domain max";
-      if (when == "at the start") throw std::invalid_argument(m.str());
-      throw std::runtime_error(m.str());
-    }
+    if (bad >= 0) throw_outside(bad, when);
+  }
+
+  // The message of check_inside for particle `bad`.
+  [[noreturn]] void throw_outside(LO bad, const std::string& when) const {
+    auto xh = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), p.x);
+    std::ostringstream m;
+    m << "explicit MPM: particle " << bad << " at (";
+    for (int d = 0; d < dim; ++d) m << (d ? ", " : "") << xh(bad, d);
+    m << ") " << when << " (step " << step
+      << ") has a shape-function stencil outside the grid; enlarge MPM/domain min / domain max";
+    if (when == "at the start") throw std::invalid_argument(m.str());
+    throw std::runtime_error(m.str());
   }
 
   // sigma from the current F (the initial state, for the first report).
@@ -204,6 +211,7 @@ struct ExplicitSimulation<dim>::Impl {
   }
 
   double dt_limit() const {
+    if (known_cmax >= 0) return setup.cfl * g.dx / known_cmax;
     const auto pp = p;
     const auto mt = mats;
     double cmax = 0;
@@ -308,11 +316,14 @@ struct StepKernels {
     if (cp) {
       s.s_x.reset();
     }
+    if (s.stencils.extent(0) != p.size())
+      s.stencils = decltype(s.stencils)(Kokkos::view_alloc("xmpm_stencils", Kokkos::WithoutInitializing), p.size());
     const auto sts = s.stencils;
     Kokkos::parallel_for(
         "xmpm_p2g", Kokkos::RangePolicy<ExecSpace>(0, p.size()), KOKKOS_LAMBDA(const LO q) {
           const Vec<dim> x = pos(p, q);
-          const St& st = sts(q);
+          const St st = Shape::template stencil<dim>(g, x, p.lp(q));
+          sts(q) = st;  // the step's stencil (compute_stencils' result), read by every later kernel
           const int a = p.cls(q);
           const double mq = p.mass(q);
           auto am = sm.access();
@@ -388,8 +399,10 @@ struct StepKernels {
     auto iters = s.lr_iters;
     const auto list = s.cnodes;
     const ContactConfig cfg{s.setup.normals, s.setup.separation, s.setup.cp_delta * s.g.dx, s.setup.lr, s.M};
+    // a few tens of nodes with unequal clouds and LR iteration counts: handed out one at a time
     Kokkos::parallel_for(
-        "xmpm_normals", Kokkos::RangePolicy<ExecSpace>(0, count), KOKKOS_LAMBDA(const LO i) {
+        "xmpm_normals", Kokkos::RangePolicy<ExecSpace, Kokkos::Schedule<Kokkos::Dynamic>>(0, count).set_chunk_size(1),
+        KOKKOS_LAMBDA(const LO i) {
           const LO node = list(i);
           const int M = cfg.M;
           int present[ExplicitSimulation<dim>::kMaxClasses];
@@ -700,8 +713,8 @@ struct StepKernels {
     double dt = s.setup.fixed_dt > 0 ? s.setup.fixed_dt : limit;
     if (s.setup.fixed_dt > 0 && dt > limit) s.over_limit++;
     r.dt_limit = limit;
+    s.known_cmax = -1;  // the particles move in this step
     bin_particles(s.g, s.p, s.bins);
-    compute_stencils<dim, Shape>(s.g, s.p, s.stencils);
     s.build_constraints(s.time);
     p2g(s);
     Kokkos::fence();
@@ -793,11 +806,17 @@ ExplicitSimulation<dim>::ExplicitSimulation(ExplicitSetup<dim> setup) : impl_(st
 template <int dim>
 ExplicitSimulation<dim>::~ExplicitSimulation() = default;
 
+// The step's closing reduction: the diagnostics, the containment check
+// (check_inside) and the next step's CFL wave speed in one pass over the
+// particles (reductions of the same partition, so the same sums as three).
 template <int dim>
 ExplicitReport ExplicitSimulation<dim>::step() {
   ExplicitReport r = step_dispatch<dim>(*impl_);
-  impl_->check_inside("after the step");
-  const ExplicitReport d = diagnostics();
+  double cmax = 0;
+  LO bad = -1;
+  const ExplicitReport d = reduce_state(&cmax, &bad);
+  if (bad >= 0) impl_->throw_outside(bad, "after the step");
+  impl_->known_cmax = cmax;
   r.step = impl_->step;
   r.time = impl_->time;
   r.momentum = d.momentum;
@@ -808,10 +827,13 @@ ExplicitReport ExplicitSimulation<dim>::step() {
 }
 
 namespace {
+// Sums, except cmax and bad, which join by max (their identities 0 and -1).
 struct XDiag {
   double m[3] = {0, 0, 0};
   double ke = 0, sb = 0, sa = 0;
   long nb = 0, na = 0;
+  double cmax = 0;  // max_p (c_p + |v_p|), m/s
+  LO bad = -1;      // largest index of a particle outside the grid
   KOKKOS_INLINE_FUNCTION XDiag& operator+=(const XDiag& o) {
     for (int i = 0; i < 3; ++i) m[i] += o.m[i];
     ke += o.ke;
@@ -819,6 +841,8 @@ struct XDiag {
     sa += o.sa;
     nb += o.nb;
     na += o.na;
+    if (o.cmax > cmax) cmax = o.cmax;
+    if (o.bad > bad) bad = o.bad;
     return *this;
   }
   KOKKOS_INLINE_FUNCTION void operator+=(const volatile XDiag& o) volatile {
@@ -828,6 +852,8 @@ struct XDiag {
     sa += o.sa;
     nb += o.nb;
     na += o.na;
+    if (o.cmax > cmax) cmax = o.cmax;
+    if (o.bad > bad) bad = o.bad;
   }
 };
 }  // namespace
@@ -844,13 +870,31 @@ namespace bfemp {
 
 template <int dim>
 ExplicitReport ExplicitSimulation<dim>::diagnostics() const {
+  return reduce_state(nullptr, nullptr);
+}
+
+template <int dim>
+ExplicitReport ExplicitSimulation<dim>::reduce_state(double* cmax, LO* bad) const {
+  const bool closing = cmax != nullptr;
   const auto p = impl_->p;
   const int body = impl_->setup.stress_body;
   const int ax = impl_->setup.stress_axis;
+  const auto gg = impl_->g;
+  const auto mt = impl_->mats;
+  const bool gimp = impl_->setup.shape == XShape::UGimp;
   XDiag d;
   Kokkos::parallel_reduce(
-      "xmpm_diagnostics", Kokkos::RangePolicy<ExecSpace>(0, p.size()),
+      closing ? "xmpm_close_step" : "xmpm_diagnostics", Kokkos::RangePolicy<ExecSpace>(0, p.size()),
       KOKKOS_LAMBDA(const LO q, XDiag& a) {
+        if (closing) {
+          const Vec<dim> x = pos(p, q);
+          const bool in = gimp ? UGimp::contains<dim>(gg, x, p.lp(q)) : QuadraticBSpline::contains<dim>(gg, x, p.lp(q));
+          if (!in && q > a.bad) a.bad = q;
+          double v2 = 0;
+          for (int c = 0; c < dim; ++c) v2 += p.v(q, c) * p.v(q, c);
+          const double cq = x_wave_speed(mt(p.cls(q)), getF(p, q).determinant()) + std::sqrt(v2);
+          if (cq > a.cmax) a.cmax = cq;
+        }
         double v2 = 0;
         for (int c = 0; c < dim; ++c) {
           a.m[c] += p.mass(q) * p.v(q, c);
@@ -865,6 +909,10 @@ ExplicitReport ExplicitSimulation<dim>::diagnostics() const {
         }
       },
       Kokkos::Sum<XDiag>(d));
+  if (closing) {
+    *cmax = d.cmax;
+    *bad = d.bad;
+  }
   ExplicitReport r;
   r.step = impl_->step;
   r.time = impl_->time;
@@ -933,6 +981,7 @@ void ExplicitSimulation<dim>::restore(const ExplicitState& s) {
   impl_->time = s.time;
   impl_->step = s.step;
   impl_->over_limit = s.over_limit;
+  impl_->known_cmax = -1;
   impl_->update_stress_only();
   impl_->check_inside("at the restart");
 }

@@ -102,6 +102,10 @@ class ExplicitSimulation {
   struct Impl;  // implementation detail (explicit_simulation.cpp), public for its kernels
 
  private:
+  // The state's diagnostics; with cmax and bad (the step's closing pass) also
+  // max_p (c_p + |v_p|) and the largest index of a particle outside the grid
+  // (-1: none), in the same pass.
+  ExplicitReport reduce_state(double* cmax, LO* bad) const;
   std::unique_ptr<Impl> impl_;
 };
 
