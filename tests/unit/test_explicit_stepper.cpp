@@ -244,4 +244,51 @@ TEST(ExplicitStepper, StrainUpdateOrderingsFromRest) {
   EXPECT_EQ(f.x, a.x);
 }
 
+// The CFL limit of the state after a step comes from the step's closing
+// reduction (with the diagnostics and the containment check), not a pass of
+// its own. It must be the limit of that state: CFL dx / max_p (c_p + |v_p|),
+// c_p from Eq. 18's tangent P-wave modulus M_t = K/2 (J + 1/J) + 4/3 G J^(-5/3)
+// (c = sqrt(M_t J / rho)), recomputed here on the host; a limit left over
+// from the state before the step fails (the collision changes |v| and J by
+// far more than the tolerance each step). After restore() it is the restored
+// state's.
+TEST(ExplicitStepper, CflLimitAfterAStepAndARestoreIsTheStatesOwn) {
+  const double dx = 0.005;
+  ExplicitSetup<2> s = base<2>(2, dx, 24, xmpm::ContactLaw::Frictionless);
+  const Particles<2> a = block<2>({-0.011, 0.0}, {0.02, 0.02}, dx, 0, {20.0, 3.0});
+  const Particles<2> b = block<2>({0.011, 0.001}, {0.02, 0.02}, dx, 1, {-20.0, 0.0});
+  s.particles = concatenate(std::vector<Particles<2>>{a, b});
+  ExplicitSimulation<2> sim(s);
+  auto host_limit = [&] {
+    const auto& p = sim.particles();
+    auto v = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), p.v);
+    auto F = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), p.F);
+    const double K = s.materials[0].kg.K, G = s.materials[0].kg.G, rho = s.materials[0].density;
+    double cmax = 0;
+    for (std::size_t q = 0; q < v.extent(0); ++q) {
+      const double J = F(q, 0, 0) * F(q, 1, 1) - F(q, 0, 1) * F(q, 1, 0);
+      const double Mt = 0.5 * K * (J + 1.0 / J) + 4.0 / 3.0 * G * std::pow(J, -5.0 / 3.0);
+      cmax = std::fmax(cmax, std::sqrt(Mt * J / rho) + std::hypot(v(q, 0), v(q, 1)));
+    }
+    return s.cfl * dx / cmax;
+  };
+  EXPECT_NEAR(sim.dt_limit(), host_limit(), 1e-12 * host_limit());
+  const ExplicitState early = sim.state();
+  const double early_limit = host_limit();
+  double prev = sim.dt_limit(), changed = 0;
+  long contact_steps = 0;
+  for (int n = 0; n < 60; ++n) {
+    const ExplicitReport r = sim.step();
+    contact_steps += r.active_nodes > 0;
+    const double want = host_limit();
+    ASSERT_NEAR(sim.dt_limit(), want, 1e-12 * want) << "after step " << n + 1;
+    changed = std::fmax(changed, std::fabs(want - prev) / want);
+    prev = want;
+  }
+  EXPECT_GT(contact_steps, 0);
+  EXPECT_GT(changed, 1e-9);  // the limit moves by more than the tolerance: a stale one would fail
+  sim.restore(early);
+  EXPECT_NEAR(sim.dt_limit(), early_limit, 1e-12 * early_limit);
+}
+
 }  // namespace
