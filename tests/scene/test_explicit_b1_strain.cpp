@@ -127,6 +127,10 @@
 // (penalty 1e-3 dx^2: <= 0.06 % except a 0.89 % spike at 5.2 %, the crossing),
 // and (b) release kicks at the crossings (tolerance 1e-3 dx and penalty 1e-3
 // dx^2: 0.41 %, one spike at 16.3 %, < 0.1 % elsewhere). Paper values: 0.91 %.
+// Tried 2026-12-05 and not kept: a USAVG+ ordering (NairnMPM's default: the
+// second half-increment from the updated particle momenta re-extrapolated to
+// the grid with the step's stencils, contact pass 2 applied to them again):
+// LR + XPIC(5) lost at 4.62 % strain, LR + FLIP 0.822 % (USAVG: 0.793 %).
 #ifndef B1_END_STRAIN
 #define B1_END_STRAIN 0.20
 #endif
