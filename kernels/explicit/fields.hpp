@@ -36,9 +36,12 @@ struct XParticles {
 // field's old values are overwritten, so it needs no zeroing). The same sums
 // in the same order as a duplicated Kokkos::ScatterView contributed into a
 // zeroed field, with reset and contribute as short loops (small_loops.hpp)
-// instead of two parallel launches each.
+// instead of two parallel launches each. The rows are indexed as
+// ScatterView's are: by the global-scope UniqueToken (OpenMP: the hardware
+// thread id, release a no-op, so a loop-scoped acquire needs no release).
 struct Scatter {
-  Kokkos::Experimental::UniqueToken<ExecSpace> token;  // before copies: sizes them
+  using Token = Kokkos::Experimental::UniqueToken<ExecSpace, Kokkos::Experimental::UniqueTokenScope::Global>;
+  Token token;  // before copies: sizes them
   Kokkos::View<double**, Kokkos::LayoutRight, MemSpace> copies;  // (threads, n)
   Kokkos::View<double*, MemSpace> field;
 
@@ -55,8 +58,9 @@ struct Scatter {
     double* row;
     KOKKOS_INLINE_FUNCTION double& operator()(LO i) const { return row[i]; }
   };
-  KOKKOS_INLINE_FUNCTION Access access() const { return Access{&copies(token.acquire(), 0)}; }
-  // (UniqueToken<OpenMP>::acquire is the thread's id and release a no-op; this loop-scoped use relies on it.)
+  KOKKOS_INLINE_FUNCTION Access access() const {
+    return Access{copies.data() + static_cast<std::size_t>(token.acquire()) * copies.stride(0)};
+  }
 
   void contribute() const {
     const auto c = copies;
@@ -176,7 +180,8 @@ void compute_stencils(const GridSpec<dim>& g, const XParticles<dim>& p, StencilV
 // (S in)_p = sum_i S_pi in_i^{cls p}, sum1_i^alpha = sum_{p in alpha} S_pi m_p (S in)_p;
 // out_i^alpha = sum_i^alpha / m_i^alpha (zero where m_i^alpha = 0) is left to
 // the caller (xpic_vstar fuses it with the series update). acc1, acc2: the
-// scatters onto out1, out2. second = false: the first field only (out2 untouched).
+// scatters onto the two sums (acc1.field, acc2.field). second = false: the
+// first field only (acc2 untouched).
 template <int dim, class Shape>
 void sps_sums2(const GridSpec<dim>& g, int M, const XParticles<dim>& p,
                Kokkos::View<const typename Shape::template Stencil<dim>*, MemSpace> sts,

@@ -5,6 +5,7 @@
 #include <Kokkos_Timer.hpp>
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <sstream>
 #include <stdexcept>
 #include <type_traits>
@@ -323,7 +324,7 @@ struct StepKernels {
         "xmpm_p2g", Kokkos::RangePolicy<ExecSpace>(0, p.size()), KOKKOS_LAMBDA(const LO q) {
           const Vec<dim> x = pos(p, q);
           const St st = Shape::template stencil<dim>(g, x, p.lp(q));
-          sts(q) = st;  // the step's stencil (compute_stencils' result), read by every later kernel
+          sts(q) = st;  // the step's stencil (what compute_stencils stores), read by every later kernel
           const int a = p.cls(q);
           const double mq = p.mass(q);
           auto am = sm.access();
@@ -832,7 +833,7 @@ struct XDiag {
   double m[3] = {0, 0, 0};
   double ke = 0, sb = 0, sa = 0;
   long nb = 0, na = 0;
-  double cmax = 0;  // max_p (c_p + |v_p|), m/s
+  double cmax = -std::numeric_limits<double>::max();  // max_p (c_p + |v_p|), m/s (as Kokkos::Max's identity)
   LO bad = -1;      // largest index of a particle outside the grid
   KOKKOS_INLINE_FUNCTION XDiag& operator+=(const XDiag& o) {
     for (int i = 0; i < 3; ++i) m[i] += o.m[i];

@@ -86,7 +86,11 @@ class ExplicitSimulation {
   ExplicitReport diagnostics() const;  // momentum, kinetic energy, stresses of the current state
   double time() const;
   long step_index() const;
-  double dt_limit() const;           // CFL * dx / max_p (c_p + |v_p|) of the current state (s)
+  // CFL * dx / max_p (c_p + |v_p|) of the current state (s). After a step it
+  // is the value of the step's closing reduction, kept until the next step or
+  // restore(): particle data written through particles()' Views between steps
+  // is not seen (nothing in bfemp does that).
+  double dt_limit() const;
   long steps_over_limit() const;     // fixed dt steps that exceeded the limit
   int num_classes() const;
   const ExplicitSetup<dim>& setup() const;

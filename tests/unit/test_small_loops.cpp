@@ -6,7 +6,9 @@
 //  - Scatter: every contribution of a parallel particle loop counted once at
 //    any thread count (integer-valued, so the sums are exact whatever the
 //    order), the field's old values overwritten, and reset() forgets the
-//    previous loop's contributions;
+//    previous loop's contributions; with random doubles, bitwise the sums of a
+//    duplicated Kokkos::ScatterView contributed into a zeroed field (the
+//    stepper's results before the Scatter replaced it);
 //  - compute_stencils stores exactly Shape::stencil of each particle (uGIMP
 //    and quadratic B-spline, 2D and 3D).
 #include <gtest/gtest.h>
@@ -15,6 +17,8 @@
 #include <limits>
 #include <random>
 #include <vector>
+
+#include <Kokkos_ScatterView.hpp>
 
 #include "kernels/explicit/fields.hpp"
 #include "kernels/explicit/shape_functions.hpp"
@@ -47,6 +51,10 @@ TEST(SmallLoops, FillAndCopyWriteEveryEntryOnBothSidesOfTheThreshold) {
   }
   Kokkos::View<double*, MemSpace> x("x", 4), y("y", 5);
   EXPECT_THROW(small_copy(x, y), std::logic_error);
+  Kokkos::View<double**, Kokkos::LayoutRight, MemSpace> r23("r23", 2, 3), r32("r32", 3, 2);
+  EXPECT_THROW(small_copy(r23, r32), std::logic_error);  // same size, other shape
+  EXPECT_THROW(small_copy(Kokkos::subview(y, std::make_pair(1, 5)), Kokkos::subview(y, std::make_pair(0, 4))),
+               std::logic_error);  // overlapping
 }
 
 TEST(SmallLoops, ReduceAndScanAgreeWithClosedFormsOnBothSidesOfTheThreshold) {
@@ -112,13 +120,50 @@ TEST(ExplicitScatter, EveryContributionCountedOnceAndTheFieldOverwritten) {
   }
 }
 
+TEST(ExplicitScatter, BitwiseTheSumsOfADuplicatedScatterView) {
+  for (const long nslots : {long(64), 3 * kSerialBelow + 5}) {
+    const long nq = 4 * nslots + 1;
+    Kokkos::View<double*, MemSpace> vals("vals", nq * 3);
+    auto hv = Kokkos::create_mirror_view(vals);
+    std::mt19937 rng(11);
+    std::uniform_real_distribution<double> u(-1.0, 1.0);
+    for (long i = 0; i < nq * 3; ++i) hv(i) = u(rng) * std::pow(10.0, int(u(rng) * 8));
+    Kokkos::deep_copy(vals, hv);
+    Kokkos::View<double*, MemSpace> mine("mine", nslots), ref("ref", nslots);
+    const Scatter s(mine);
+    s.reset();
+    Kokkos::parallel_for(
+        "mine", Kokkos::RangePolicy<ExecSpace>(0, nq), KOKKOS_LAMBDA(const long q) {
+          auto acc = s.access();
+          for (int k = 0; k < 3; ++k) acc((q * 5 + k * 17) % nslots) += vals(q * 3 + k);
+        });
+    s.contribute();
+    using SV = Kokkos::Experimental::ScatterView<double*, Kokkos::LayoutRight, ExecSpace,
+                                                 Kokkos::Experimental::ScatterSum,
+                                                 Kokkos::Experimental::ScatterDuplicated,
+                                                 Kokkos::Experimental::ScatterNonAtomic>;
+    SV sv(ref);
+    sv.reset();
+    Kokkos::parallel_for(
+        "ref", Kokkos::RangePolicy<ExecSpace>(0, nq), KOKKOS_LAMBDA(const long q) {
+          auto acc = sv.access();
+          for (int k = 0; k < 3; ++k) acc((q * 5 + k * 17) % nslots) += vals(q * 3 + k);
+        });
+    Kokkos::deep_copy(ref, 0.0);
+    Kokkos::Experimental::contribute(ref, sv);
+    auto hm = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), mine);
+    auto hr = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), ref);
+    for (long i = 0; i < nslots; ++i) ASSERT_EQ(hm(i), hr(i)) << "slots " << nslots << ", slot " << i;
+  }
+}
+
 template <int dim, class Shape>
 void check_stencils(double lp) {
   GridSpec<dim> g;
-  g.dx = 0.01;
+  g.dx = 1.0 / 128;  // powers of two: the first particles lie exactly on grid lines
   for (int d = 0; d < dim; ++d) {
-    g.origin[d] = -0.1;
-    g.n_cells[d] = 20;
+    g.origin[d] = -0.125;
+    g.n_cells[d] = 32;
   }
   const long n = 500;
   XParticles<dim> p;
@@ -127,9 +172,9 @@ void check_stencils(double lp) {
   p.mass = Kokkos::View<double*, MemSpace>("m", n);
   auto hx = Kokkos::create_mirror_view(p.x);
   std::mt19937 rng(3);
-  std::uniform_real_distribution<double> u(-0.07, 0.07);
+  std::uniform_real_distribution<double> u(-0.09, 0.09);
   for (long q = 0; q < n; ++q)
-    for (int d = 0; d < dim; ++d) hx(q, d) = q < 8 ? -0.05 + 0.01 * q : u(rng);  // some exactly on grid lines
+    for (int d = 0; d < dim; ++d) hx(q, d) = q < 8 ? -0.0625 + q / 128.0 : u(rng);  // the first 8 on grid lines
   Kokkos::deep_copy(p.x, hx);
   Kokkos::deep_copy(p.lp, lp);
   StencilView<dim, Shape> sts;
@@ -151,10 +196,10 @@ void check_stencils(double lp) {
 }
 
 TEST(ExplicitStencils, ComputeStencilsStoresEachParticlesStencil) {
-  check_stencils<2, UGimp>(0.0025);
-  check_stencils<3, UGimp>(0.0025);
-  check_stencils<2, QuadraticBSpline>(0.0025);
-  check_stencils<3, QuadraticBSpline>(0.0025);
+  check_stencils<2, UGimp>(1.0 / 512);
+  check_stencils<3, UGimp>(1.0 / 512);
+  check_stencils<2, QuadraticBSpline>(1.0 / 512);
+  check_stencils<3, QuadraticBSpline>(1.0 / 512);
 }
 
 }  // namespace
