@@ -203,23 +203,19 @@ void sps_sums2(const GridSpec<dim>& g, int M, const XParticles<dim>& p,
           sl[k] = (st.node(g, k) * M + a) * dim;
         }
         const double mq = p.mass(q);
-        double v1[dim] = {};
-        for (int k = 0; k < St::size; ++k)
-          for (int c = 0; c < dim; ++c) v1[c] += w[k] * in1(sl[k] + c);
-        auto o1 = a1.access();
-        for (int k = 0; k < St::size; ++k) {
-          const double wm = w[k] * mq;
-          for (int c = 0; c < dim; ++c) o1(sl[k] + c) += wm * v1[c];
-        }
-        if (!second) return;
-        double v2[dim] = {};
-        for (int k = 0; k < St::size; ++k)
-          for (int c = 0; c < dim; ++c) v2[c] += w[k] * in2(sl[k] + c);
-        auto o2 = a2.access();
-        for (int k = 0; k < St::size; ++k) {
-          const double wm = w[k] * mq;
-          for (int c = 0; c < dim; ++c) o2(sl[k] + c) += wm * v2[c];
-        }
+        // (S in)_p, then S_pi m_p (S in)_p into the scatter
+        auto sweep = [&](const Kokkos::View<const double*, MemSpace>& in, const Scatter& acc) {
+          double vp[dim] = {};
+          for (int k = 0; k < St::size; ++k)
+            for (int c = 0; c < dim; ++c) vp[c] += w[k] * in(sl[k] + c);
+          auto o = acc.access();
+          for (int k = 0; k < St::size; ++k) {
+            const double wm = w[k] * mq;
+            for (int c = 0; c < dim; ++c) o(sl[k] + c) += wm * vp[c];
+          }
+        };
+        sweep(in1, a1);
+        if (second) sweep(in2, a2);
       });
   acc1.contribute();
   if (second) acc2.contribute();
