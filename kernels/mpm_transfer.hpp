@@ -38,7 +38,8 @@ LO particle_outside(const GridSpec<dim>& grid, const Particles<dim>& p) {
 
 // Marks the nodes touched by particle stencils and numbers them: system_node(n)
 // = first + rank among active nodes, or -1. Returns the active count and fills
-// grid_node(k) = linear grid index of active node k (resized when too small).
+// grid_node(k) = linear grid index of active node k, k < the returned count
+// (grown with headroom when too small; entries past the count are stale).
 template <int dim>
 LO activate_grid(const GridSpec<dim>& grid, const Particles<dim>& p, LO first,
                  Kokkos::View<LO*, MemSpace> system_node, Kokkos::View<LO*, MemSpace>& grid_node) {
@@ -58,7 +59,9 @@ LO activate_grid(const GridSpec<dim>& grid, const Particles<dim>& p, LO first,
         offset += flag;
       },
       count);
-  if (static_cast<LO>(grid_node.extent(0)) < count) grid_node = Kokkos::View<LO*, MemSpace>("mpm_grid_node", count);
+  // capacity with headroom: the active set changes most steps
+  if (static_cast<LO>(grid_node.extent(0)) < count)
+    grid_node = Kokkos::View<LO*, MemSpace>("mpm_grid_node", count + count / 4 + 16);
   auto gn = grid_node;
   Kokkos::parallel_for(
       "mpm_active_list", Kokkos::RangePolicy<ExecSpace>(0, system_node.extent(0)), KOKKOS_LAMBDA(const LO n) {

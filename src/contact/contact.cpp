@@ -263,16 +263,18 @@ typename Contact<dim>::Report Contact<dim>::report(ConstDofView x, LO n_fem_node
   r.barrier_energy = barrier_->energy(x);
   r.ccd_alpha_min = barrier_->take_ccd_min();
   r.timings = barrier_->take_timings();  // of the solve (the report's own work is not counted)
-  if (grad_.extent(0) != x.extent(0)) grad_ = Kokkos::View<double*, MemSpace>("contact_grad", x.extent(0));
-  Kokkos::deep_copy(grad_, 0.0);
-  barrier_->gradient(x, 1.0, grad_);
-  if (friction_) friction_->gradient(x, 1.0, grad_);
+  // the system size follows the active grid nodes (it changes most steps): capacity with headroom
+  if (grad_.extent(0) < x.extent(0)) grad_ = Kokkos::View<double*, MemSpace>("contact_grad", x.extent(0) + x.extent(0) / 4 + 16);
+  const Kokkos::View<double*, MemSpace> gx = Kokkos::subview(grad_, std::make_pair(std::size_t(0), x.extent(0)));
+  Kokkos::deep_copy(gx, 0.0);
+  barrier_->gradient(x, 1.0, gx);
+  if (friction_) friction_->gradient(x, 1.0, gx);
   LO first = 0, count = n_fem_nodes;
   if (params_.force_body >= 0) {
     first = mesh_.bodies[params_.force_body].first_node;
     count = mesh_.bodies[params_.force_body].num_nodes;
   }
-  const auto g = grad_;
+  const auto g = gx;
   double f[3] = {0, 0, 0};
   for (int c = 0; c < dim; ++c)
     Kokkos::parallel_reduce(
