@@ -11,6 +11,7 @@
 #include <utility>
 #include <vector>
 
+#include "solver/cholmod_common.hpp"
 #include "solver/cholmod_views.hpp"
 #include "solver/solver_error.hpp"
 
@@ -45,10 +46,7 @@ struct BlockCholmod::Impl {
   Kokkos::View<double*, MemSpace> rhs;                 // apply(): [owned; ghosts], contiguous for CHOLMOD
 
   Impl() {
-    cholmod_l_start(&c);
-    c.print = 0;
-    c.error_handler = nullptr;  // errors come back as c.status
-    c.final_ll = 1;             // simplicial factors as LL': a non-positive pivot is reported
+    start_cholmod(c);  // LL' factors, relaxed supernodes (solver/cholmod_common.hpp)
   }
   ~Impl() {
     if (L) cholmod_l_free_factor(&L, &c);
@@ -179,17 +177,20 @@ void BlockCholmod::compute() {
   Kokkos::fence();
   cholmod_sparse S = m.view();
   int status = CHOLMOD_OK;
-  if (!m.analysed && S.nrow > 0) {
-    m.L = cholmod_l_analyze(&S, &m.c);
-    status = m.L ? m.c.status : CHOLMOD_INVALID;
-    m.analysed = m.L != nullptr;
-    m.fl = m.c.fl;
-    m.lnz = m.c.lnz;
-  }
   m.factored = false;
-  if (status >= CHOLMOD_OK && S.nrow > 0) {
-    if (!cholmod_l_factorize(&S, m.L, &m.c)) status = m.c.status == CHOLMOD_OK ? CHOLMOD_INVALID : m.c.status;
-    else status = m.c.status;
+  {
+    CholmodSerialScope serial;
+    if (!m.analysed && S.nrow > 0) {
+      m.L = cholmod_l_analyze(&S, &m.c);
+      status = m.L ? m.c.status : CHOLMOD_INVALID;
+      m.analysed = m.L != nullptr;
+      m.fl = m.c.fl;
+      m.lnz = m.c.lnz;
+    }
+    if (status >= CHOLMOD_OK && S.nrow > 0) {
+      if (!cholmod_l_factorize(&S, m.L, &m.c)) status = m.c.status == CHOLMOD_OK ? CHOLMOD_INVALID : m.c.status;
+      else status = m.c.status;
+    }
   }
   // Every rank learns of a failure on any rank (a CG on the others would wait).
   int worst_local = status == CHOLMOD_OK ? 0 : (status == CHOLMOD_NOT_POSDEF ? 1 : 2);
@@ -229,6 +230,7 @@ void BlockCholmod::apply(const MultiVec& Xin, MultiVec& Yout, Teuchos::ETransp, 
     const double* s = nullptr;
     if (n > 0) {
       cholmod_dense B = dense_column_view(rhs.data(), n);
+      CholmodSerialScope serial;
       if (!cholmod_l_solve2(CHOLMOD_A, m.L, &B, nullptr, &m.X, nullptr, &m.Y, &m.E, &m.c) || m.c.status != CHOLMOD_OK)
         throw SolverError("block Cholesky preconditioner (BLOCK_CHOLMOD): CHOLMOD solve status " +
                           std::to_string(m.c.status));

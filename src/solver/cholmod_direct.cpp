@@ -9,6 +9,7 @@
 #include <utility>
 #include <vector>
 
+#include "solver/cholmod_common.hpp"
 #include "solver/cholmod_views.hpp"
 #include "solver/solver_error.hpp"
 
@@ -49,13 +50,7 @@ struct CholmodDirect::Impl {
   V cg_x, cg_r, cg_z, cg_p, cg_q;  // CG work, sized once per graph
 
   explicit Impl(Reuse r) : reuse(r) {
-    cholmod_l_start(&c);
-    c.print = 0;
-    c.error_handler = nullptr;  // errors come back as c.status
-    // Simplicial factors (small or very sparse matrices) as LL', not LDL':
-    // LDL' reports only an exactly zero pivot, so an indefinite exact Hessian
-    // would pass as definite. (Supernodal factors are always LL'.)
-    c.final_ll = 1;
+    start_cholmod(c);  // LL' factors, relaxed supernodes (solver/cholmod_common.hpp)
   }
   ~Impl() {
     if (L) cholmod_l_free_factor(&L, &c);
@@ -136,7 +131,10 @@ static bool cg_on_old_factor(CholmodDirect::Reuse reuse, cholmod_common& c, chol
   const double stop = reuse.tolerance * bn;
   auto precondition = [&]() {  // z = (L L^T)^-1 r
     cholmod_dense R = dense_column_view(r.data(), n);
-    if (!cholmod_l_solve2(CHOLMOD_A, L, &R, nullptr, &X, nullptr, &Y, &E, &c) || c.status != CHOLMOD_OK) return false;
+    {
+      CholmodSerialScope serial;
+      if (!cholmod_l_solve2(CHOLMOD_A, L, &R, nullptr, &X, nullptr, &Y, &E, &c) || c.status != CHOLMOD_OK) return false;
+    }
     const double* xs = static_cast<const double*>(X->x);
     Kokkos::parallel_for("cholmod_cg_z", Range(0, n), KOKKOS_LAMBDA(const std::size_t k) { z(k) = xs[k]; });
     return true;
@@ -208,6 +206,7 @@ CholmodDirect::Result CholmodDirect::solve(const Vector& b, Vector& x) {
     }
   }
   cholmod_sparse S = m.view();
+  CholmodSerialScope serial;  // to the end: no Kokkos kernel below (host Views: no copies)
   bool analysed_now = false;
   if (!m.analysed) {
     m.L = cholmod_l_analyze(&S, &m.c);
