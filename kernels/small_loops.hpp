@@ -6,7 +6,7 @@
 // (an empty loop; Kokkos::Serial: 0.03 µs); the explicit step of B1 at the
 // paper's size launched ~75 per step, which made 2 threads slower than 1. A loop over grid slots or
 // contact nodes costs a few ns per iteration, so below kSerialBelow
-// iterations it runs on the calling thread (Kokkos::Serial, the same
+// iterations (a caller's serial_below for costlier bodies) it runs on the calling thread (Kokkos::Serial, the same
 // HostSpace memory) and above it on ExecSpace. The loop body is the same
 // either way; element-wise loops and integer reductions give identical
 // results, and a floating-point reduction over fewer than kSerialBelow items
@@ -26,6 +26,10 @@
 namespace bfemp {
 
 inline constexpr long kSerialBelow = 8192;
+// For loop bodies of ~50-100 ns (a spatial-hash query, a particle's stencil
+// sum): at 2 threads a launch pays for itself from about 7 us / (cost / 2)
+// iterations.
+inline constexpr long kSerialBelowHeavy = 128;
 
 static_assert(Kokkos::SpaceAccessibility<Kokkos::Serial, MemSpace>::accessible,
               "small_for runs short loops on Kokkos::Serial: MemSpace must be host memory");
@@ -33,8 +37,8 @@ static_assert(std::is_same_v<typename ExecSpace::memory_space, Kokkos::HostSpace
               "small_loops.hpp switches between ExecSpace and Kokkos::Serial: ExecSpace must be a host space");
 
 template <class F>
-void small_for(const char* name, long n, const F& f) {
-  if (n < kSerialBelow) {
+void small_for(const char* name, long n, const F& f, long serial_below = kSerialBelow) {
+  if (n < serial_below) {
     ExecSpace().fence();
     Kokkos::parallel_for(name, Kokkos::RangePolicy<Kokkos::Serial>(0, n), f);
   } else {
@@ -43,8 +47,8 @@ void small_for(const char* name, long n, const F& f) {
 }
 
 template <class F, class R>
-void small_reduce(const char* name, long n, const F& f, R&& result) {
-  if (n < kSerialBelow) {
+void small_reduce(const char* name, long n, const F& f, R&& result, long serial_below = kSerialBelow) {
+  if (n < serial_below) {
     ExecSpace().fence();
     Kokkos::parallel_reduce(name, Kokkos::RangePolicy<Kokkos::Serial>(0, n), f, result);
   } else {
@@ -53,8 +57,8 @@ void small_reduce(const char* name, long n, const F& f, R&& result) {
 }
 
 template <class F, class T>
-void small_scan(const char* name, long n, const F& f, T& total) {
-  if (n < kSerialBelow) {
+void small_scan(const char* name, long n, const F& f, T& total, long serial_below = kSerialBelow) {
+  if (n < serial_below) {
     ExecSpace().fence();
     Kokkos::parallel_scan(name, Kokkos::RangePolicy<Kokkos::Serial>(0, n), f, total);
   } else {

@@ -47,6 +47,7 @@
 #include <string>
 
 #include "core/types.hpp"
+#include "kernels/small_loops.hpp"
 
 namespace bfemp {
 
@@ -283,18 +284,19 @@ class SpatialHash {
     const auto tr = t_;
     const auto qlo = queries.lo, qhi = queries.hi;
     const auto off = offsets_;
-    Kokkos::parallel_for(
-        "bp_query_count", Kokkos::RangePolicy<ExecSpace>(0, m), KOKKOS_LAMBDA(const LO q) {
+    small_for(
+        "bp_query_count", m, KOKKOS_LAMBDA(const LO q) {
           double lo[dim], hi[dim];
           for (int d = 0; d < dim; ++d) lo[d] = qlo(q, d), hi[d] = qhi(q, d);
           std::int64_t c = 0;
           auto emit = [&](LO j) { c += keep(q, j) ? 1 : 0; };
           tr.visit(lo, hi, emit);
           off(q) = c;
-        });
+        },
+        kSerialBelowHeavy);
     std::int64_t total = 0;
-    Kokkos::parallel_scan(
-        "bp_query_scan", Kokkos::RangePolicy<ExecSpace>(0, m + 1),
+    small_scan(
+        "bp_query_scan", m + 1,
         KOKKOS_LAMBDA(const LO q, std::int64_t& acc, const bool final) {
           const std::int64_t c = q < m ? off(q) : 0;
           if (final) off(q) = acc;
@@ -306,8 +308,8 @@ class SpatialHash {
       pairs = Kokkos::View<LO* [2], MemSpace>(Kokkos::view_alloc(Kokkos::WithoutInitializing, "bfemp_contact_pairs"),
                                               total + total / 4);
     const auto pr = pairs;
-    Kokkos::parallel_for(
-        "bp_query_fill", Kokkos::RangePolicy<ExecSpace>(0, m), KOKKOS_LAMBDA(const LO q) {
+    small_for(
+        "bp_query_fill", m, KOKKOS_LAMBDA(const LO q) {
           double lo[dim], hi[dim];
           for (int d = 0; d < dim; ++d) lo[d] = qlo(q, d), hi[d] = qhi(q, d);
           std::int64_t k = off(q);
@@ -319,7 +321,8 @@ class SpatialHash {
           };
           tr.visit(lo, hi, emit);
           sort_segment(pr, off(q), k);
-        });
+        },
+        kSerialBelowHeavy);
     return static_cast<LO>(total);
   }
 
@@ -334,8 +337,8 @@ class SpatialHash {
  private:
   void copy_boxes(const Boxes<dim>& in) {
     const auto ilo = in.lo, ihi = in.hi, lo = boxes_.lo, hi = boxes_.hi;
-    Kokkos::parallel_for(
-        "bp_copy_boxes", Kokkos::RangePolicy<ExecSpace>(0, in.size()), KOKKOS_LAMBDA(const LO i) {
+    small_for(
+        "bp_copy_boxes", in.size(), KOKKOS_LAMBDA(const LO i) {
           for (int d = 0; d < dim; ++d) lo(i, d) = ilo(i, d), hi(i, d) = ihi(i, d);
         });
     t_.lo = lo;
@@ -346,11 +349,11 @@ class SpatialHash {
     const auto lo = boxes_.lo, hi = boxes_.hi;
     for (int d = 0; d < dim; ++d) {
       double a = 0, b = 0;
-      Kokkos::parallel_reduce(
-          "bp_scene_lo", Kokkos::RangePolicy<ExecSpace>(0, boxes_.size()),
+      small_reduce(
+          "bp_scene_lo", boxes_.size(),
           KOKKOS_LAMBDA(const LO i, double& acc) { acc = broad_phase_detail::dmin(acc, lo(i, d)); }, Kokkos::Min<double>(a));
-      Kokkos::parallel_reduce(
-          "bp_scene_hi", Kokkos::RangePolicy<ExecSpace>(0, boxes_.size()),
+      small_reduce(
+          "bp_scene_hi", boxes_.size(),
           KOKKOS_LAMBDA(const LO i, double& acc) { acc = broad_phase_detail::dmax(acc, hi(i, d)); }, Kokkos::Max<double>(b));
       t_.scene_lo[d] = a;
       t_.scene_hi[d] = b;
@@ -362,10 +365,10 @@ class SpatialHash {
   double median_side_cell(double L) {
     broad_phase_detail::grow(hist_, 64, "bfemp_bp_hist");
     const auto hist = Kokkos::subview(hist_, Kokkos::make_pair(0, 64));
-    Kokkos::deep_copy(hist, 0);
+    small_fill(hist, 0);
     const auto lo = boxes_.lo, hi = boxes_.hi;
-    Kokkos::parallel_for(
-        "bp_side_histogram", Kokkos::RangePolicy<ExecSpace>(0, boxes_.size()), KOKKOS_LAMBDA(const LO i) {
+    small_for(
+        "bp_side_histogram", boxes_.size(), KOKKOS_LAMBDA(const LO i) {
           double s = 0;
           for (int d = 0; d < dim; ++d) s = broad_phase_detail::dmax(s, hi(i, d) - lo(i, d));
           int b = 63;  // degenerate
@@ -400,8 +403,8 @@ class SpatialHash {
     constexpr std::int64_t cap = kCellCap;
     entries = 0;
     over = 0;
-    Kokkos::parallel_reduce(
-        "bp_count_entries", Kokkos::RangePolicy<ExecSpace>(0, boxes_.size()),
+    small_reduce(
+        "bp_count_entries", boxes_.size(),
         KOKKOS_LAMBDA(const LO i, std::int64_t& acc) {
           LO c0[dim], c1[dim];
           g.range(lo, hi, i, c0, c1);
@@ -409,8 +412,8 @@ class SpatialHash {
           if (c <= cap) acc += c;
         },
         entries);
-    Kokkos::parallel_reduce(
-        "bp_count_oversize", Kokkos::RangePolicy<ExecSpace>(0, boxes_.size()),
+    small_reduce(
+        "bp_count_oversize", boxes_.size(),
         KOKKOS_LAMBDA(const LO i, LO& acc) {
           LO c0[dim], c1[dim];
           g.range(lo, hi, i, c0, c1);
@@ -431,8 +434,8 @@ class SpatialHash {
     const auto list = t_.oversize;
     constexpr std::int64_t cap = kCellCap;
     LO count = 0;
-    Kokkos::parallel_scan(
-        "bp_oversize_list", Kokkos::RangePolicy<ExecSpace>(0, n),
+    small_scan(
+        "bp_oversize_list", n,
         KOKKOS_LAMBDA(const LO i, LO& acc, const bool final) {
           LO c0[dim], c1[dim];
           g.range(lo, hi, i, c0, c1);
@@ -455,12 +458,12 @@ class SpatialHash {
     grow(t_.entry_key, entries, "bfemp_bp_entry_key");
     grow(t_.entry_box, entries, "bfemp_bp_entry_box");
     const auto start = t_.bucket_start;
-    Kokkos::deep_copy(Kokkos::subview(start, Kokkos::make_pair(0, buckets + 1)), 0);
+    small_fill(Kokkos::subview(start, Kokkos::make_pair(0, buckets + 1)), 0);
     const auto g = t_.grid;
     const auto lo = boxes_.lo, hi = boxes_.hi;
     const auto flag = t_.is_oversize;
-    Kokkos::parallel_for(
-        "bp_bucket_count", Kokkos::RangePolicy<ExecSpace>(0, boxes_.size()), KOKKOS_LAMBDA(const LO i) {
+    small_for(
+        "bp_bucket_count", boxes_.size(), KOKKOS_LAMBDA(const LO i) {
           if (flag(i)) return;
           LO c0[dim], c1[dim];
           g.range(lo, hi, i, c0, c1);
@@ -468,8 +471,8 @@ class SpatialHash {
           for_each_cell<dim>(c0, c1, add);
         });
     LO total = 0;
-    Kokkos::parallel_scan(
-        "bp_bucket_scan", Kokkos::RangePolicy<ExecSpace>(0, buckets + 1),
+    small_scan(
+        "bp_bucket_scan", buckets + 1,
         KOKKOS_LAMBDA(const LO b, LO& acc, const bool final) {
           const LO c = start(b);
           if (final) start(b) = acc;
@@ -477,12 +480,12 @@ class SpatialHash {
         },
         total);
     const auto cur = cursor_;
-    Kokkos::parallel_for(
-        "bp_cursor_init", Kokkos::RangePolicy<ExecSpace>(0, buckets), KOKKOS_LAMBDA(const LO b) { cur(b) = start(b); });
+    small_for(
+        "bp_cursor_init", buckets, KOKKOS_LAMBDA(const LO b) { cur(b) = start(b); });
     const auto ekey = t_.entry_key;
     const auto ebox = t_.entry_box;
-    Kokkos::parallel_for(
-        "bp_bucket_fill", Kokkos::RangePolicy<ExecSpace>(0, boxes_.size()), KOKKOS_LAMBDA(const LO i) {
+    small_for(
+        "bp_bucket_fill", boxes_.size(), KOKKOS_LAMBDA(const LO i) {
           if (flag(i)) return;
           LO c0[dim], c1[dim];
           g.range(lo, hi, i, c0, c1);
@@ -514,8 +517,8 @@ void point_boxes(Kokkos::View<const double*, MemSpace> x, Kokkos::View<const dou
                                 std::to_string(x.extent(0)));
   out.resize(static_cast<LO>(x.extent(0) / dim));
   const auto lo = out.lo, hi = out.hi;
-  Kokkos::parallel_for(
-      "bp_point_boxes", Kokkos::RangePolicy<ExecSpace>(0, out.size()), KOKKOS_LAMBDA(const LO i) {
+  small_for(
+      "bp_point_boxes", out.size(), KOKKOS_LAMBDA(const LO i) {
         for (int c = 0; c < dim; ++c) {
           const double a = x(i * dim + c), b = moving ? a + t * dx(i * dim + c) : a;
           lo(i, c) = broad_phase_detail::dmin(a, b) - pad;
@@ -541,8 +544,8 @@ void simplex_boxes(Kokkos::View<const LO* [k], MemSpace> nodes, Kokkos::View<con
                                 std::to_string(x.extent(0)));
   out.resize(static_cast<LO>(nodes.extent(0)));
   const auto lo = out.lo, hi = out.hi;
-  Kokkos::parallel_for(
-      "bp_simplex_boxes", Kokkos::RangePolicy<ExecSpace>(0, out.size()), KOKKOS_LAMBDA(const LO i) {
+  small_for(
+      "bp_simplex_boxes", out.size(), KOKKOS_LAMBDA(const LO i) {
         for (int c = 0; c < dim; ++c) {
           double mn = x(nodes(i, 0) * dim + c), mx = mn;
           for (int a = 0; a < k; ++a) {

@@ -16,6 +16,7 @@
 #include "kernels/contact/barrier.hpp"
 #include "kernels/contact/distance.hpp"
 #include "kernels/mpm/bspline.hpp"
+#include "kernels/small_loops.hpp"
 
 namespace bfemp {
 
@@ -57,14 +58,16 @@ KOKKOS_INLINE_FUNCTION double particle_contact_weight(double volume0) {
 template <int dim>
 void interpolate_particles(const ParticleStencils<dim>& ps, Kokkos::View<const double*, MemSpace> x,
                            Kokkos::View<double*, MemSpace> xq) {
-  Kokkos::parallel_for(
-      "contact_interpolate", Kokkos::RangePolicy<ExecSpace>(0, ps.size()), KOKKOS_LAMBDA(const LO q) {
+  small_for(
+      "contact_interpolate", ps.size(),
+      KOKKOS_LAMBDA(const LO q) {
         for (int c = 0; c < dim; ++c) {
           double s = 0;
           for (int a = 0; a < ParticleStencils<dim>::ns; ++a) s += ps.w(q, a) * x(ps.nodes(q, a) * dim + c);
           xq(q * dim + c) = s;
         }
-      });
+      },
+      kSerialBelow / 16);  // a 20-60 ns body
 }
 
 // Runs of equal particle in a pair list (pairs(k, 0) = particle): seg(s) is
@@ -75,14 +78,14 @@ inline LO particle_segments(const Kokkos::View<LO* [2], MemSpace>& pairs, LO n, 
   if (static_cast<LO>(seg.extent(0)) < n + 1) seg = Kokkos::View<LO*, MemSpace>("pair_segments", n + n / 4 + 16);
   const auto out = seg;
   LO count = 0;
-  Kokkos::parallel_scan(
-      "pair_segments", Kokkos::RangePolicy<ExecSpace>(0, n), KOKKOS_LAMBDA(const LO k, LO& offset, const bool final) {
+  small_scan(
+      "pair_segments", n, KOKKOS_LAMBDA(const LO k, LO& offset, const bool final) {
         const bool first = k == 0 || pairs(k, 0) != pairs(k - 1, 0);
         if (first && final) out(offset) = k;
         offset += first ? 1 : 0;
       },
       count);
-  Kokkos::deep_copy(Kokkos::subview(out, count), n);
+  out(count) = n;  // host memory (small_loops.hpp asserts it); the scan has finished
   return count;
 }
 

@@ -3,6 +3,7 @@
 //  - small_fill / small_copy / small_reduce / small_scan give the same results
 //    below and above kSerialBelow (where they switch from Kokkos::Serial to
 //    ExecSpace): every entry written, integer sums exact, exclusive prefix sums;
+//    a caller's serial_below moves the switch;
 //  - Scatter: every contribution of a parallel particle loop counted once at
 //    any thread count (integer-valued, so the sums are exact whatever the
 //    order), the field's old values overwritten, and reset() forgets the
@@ -12,6 +13,7 @@
 //  - compute_stencils stores exactly Shape::stencil of each particle (uGIMP
 //    and quadratic B-spline, 2D and 3D).
 #include <gtest/gtest.h>
+#include <omp.h>
 
 #include <cmath>
 #include <limits>
@@ -80,6 +82,41 @@ TEST(SmallLoops, ReduceAndScanAgreeWithClosedFormsOnBothSidesOfTheThreshold) {
     EXPECT_EQ(total, n * (n - 1) / 2) << "n = " << n;
     auto hp = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), prefix);
     for (long i = 0; i < n; ++i) ASSERT_EQ(hp(i), i * (i - 1) / 2) << "n = " << n << ", i = " << i;
+  }
+}
+
+// The caller's threshold decides where a loop runs: below it on the calling
+// thread (no OpenMP region), at or above it on ExecSpace (inside one, when the
+// pool has more than one thread); every iteration runs once either way.
+TEST(SmallLoops, TheCallersThresholdChoosesTheSpace) {
+  const long n = 200;
+  for (const long below : {kSerialBelowHeavy, n, n + 1, kSerialBelow}) {
+    Kokkos::View<int*, MemSpace> ran("ran", n), inside("inside", n);
+    small_for(
+        "threshold_for", n,
+        KOKKOS_LAMBDA(const long i) {
+          ran(i) += 1;
+          inside(i) = omp_in_parallel() ? 1 : 0;
+        },
+        below);
+    Kokkos::fence();
+    int runs = 0, parallel = 0;
+    for (long i = 0; i < n; ++i) runs += ran(i) == 1, parallel += inside(i);
+    EXPECT_EQ(runs, n) << "serial_below = " << below;
+    if (n < below) {
+      EXPECT_EQ(parallel, 0) << "serial_below = " << below;
+    } else if (ExecSpace().concurrency() > 1) {
+      EXPECT_EQ(parallel, n) << "serial_below = " << below;
+    }
+    long sum = 0;
+    small_reduce(
+        "threshold_reduce", n, KOKKOS_LAMBDA(const long i, long& acc) { acc += omp_in_parallel() ? 0 : i; }, sum,
+        below);
+    if (n < below) {
+      EXPECT_EQ(sum, n * (n - 1) / 2) << "serial_below = " << below;
+    } else if (ExecSpace().concurrency() > 1) {
+      EXPECT_EQ(sum, 0) << "serial_below = " << below;
+    }
   }
 }
 
