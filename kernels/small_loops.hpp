@@ -9,7 +9,7 @@
 // iterations (a caller's serial_below for costlier bodies) it runs on the calling thread (Kokkos::Serial, the same
 // HostSpace memory) and above it on ExecSpace. The loop body is the same
 // either way; element-wise loops and integer reductions give identical
-// results, and a floating-point reduction over fewer than kSerialBelow items
+// results, and a floating-point reduction over fewer than the threshold in use
 // is summed in index order.
 //
 // Preconditions, asserted: MemSpace is host memory (Kokkos::Serial runs on
@@ -26,9 +26,10 @@
 namespace bfemp {
 
 inline constexpr long kSerialBelow = 8192;
-// For loop bodies of ~50-100 ns (a spatial-hash query, a particle's stencil
-// sum): at 2 threads a launch pays for itself from about 7 us / (cost / 2)
-// iterations.
+// For loop bodies of ~50-100 ns (a spatial-hash query): at 2 threads a launch
+// (3.5 us) pays for itself once n cost / 2 exceeds it, from about
+// 7 us / cost iterations. Callers with other costs pass their own
+// serial_below (e.g. kSerialBelow / 16 for a 20-60 ns body).
 inline constexpr long kSerialBelowHeavy = 128;
 
 static_assert(Kokkos::SpaceAccessibility<Kokkos::Serial, MemSpace>::accessible,

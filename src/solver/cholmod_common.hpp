@@ -12,9 +12,12 @@
 //     up to 16 columns always merge, up to 64 while under 80 % of their
 //     entries are fill, up to 128 under 10 %. Fewer, larger supernodes mean
 //     fewer BLAS calls and scatter passes. Measured on the rings at the
-//     paper's size (9418 DOFs, 6.7e7 flops per factorisation, 1 thread):
-//     760 supernodes -> 281, 16-20 ms -> 10-13 ms per numeric factorisation
-//     (with the serial scope below), the same flops and nnz(L) to 0.1 %.
+//     paper's size (9418 DOFs, 6.7e7 flops per factorisation before
+//     amalgamation, 1 thread): 760 supernodes -> 281, 16-20 ms -> 10-13 ms
+//     per numeric factorisation (with the serial scope below); the stored
+//     factor grows from 8.3e5 to 1.2e6 entries (L->xsize: the explicit zeros
+//     of the merged supernodes; CHOLMOD's Common->fl and lnz are counted
+//     before amalgamation and do not show it).
 //
 // Serial scope (CholmodSerialScope): Debian's SuiteSparse 5 builds CHOLMOD
 // with OpenMP and a fixed team of 4 threads (CHOLMOD_OMP_NUM_THREADS) for its
@@ -24,8 +27,10 @@
 // 16-20 ms (OMP_THREAD_LIMIT=1 gives the same 16-20 ms). The scope sets the
 // OpenMP max-active-levels to 0 for its lifetime, so every parallel region
 // opened inside it (CHOLMOD's) runs on the calling thread, and restores the
-// previous value on exit. The BLAS under CHOLMOD is OpenBLAS' own threads
-// (solver/blas_threads.hpp), not OpenMP's, and is not affected.
+// previous value on exit. The BLAS under CHOLMOD here is OpenBLAS' pthreads
+// build (solver/blas_threads.hpp), whose threads are not OpenMP's and are not
+// affected; an OpenMP build of a BLAS would run on one thread in the scope
+// too (slower, not wrong).
 // Preconditions: opened on the host thread outside any parallel region (a
 // no-op inside one), and no Kokkos kernel launched while it is open (a
 // Kokkos OpenMP kernel would then run its whole range split for the pool on

@@ -206,10 +206,12 @@ CholmodDirect::Result CholmodDirect::solve(const Vector& b, Vector& x) {
     }
   }
   cholmod_sparse S = m.view();
-  CholmodSerialScope serial;  // to the end: no Kokkos kernel below (host Views: no copies)
   bool analysed_now = false;
   if (!m.analysed) {
-    m.L = cholmod_l_analyze(&S, &m.c);
+    {
+      CholmodSerialScope serial;  // each CHOLMOD call in one, with no Kokkos kernel inside
+      m.L = cholmod_l_analyze(&S, &m.c);
+    }
     if (!m.L || m.c.status < CHOLMOD_OK)
       throw SolverError("Cholmod analysis failed: " + status_name(m.c.status));
     m.analysed = true;
@@ -224,12 +226,18 @@ CholmodDirect::Result CholmodDirect::solve(const Vector& b, Vector& x) {
   // memory).
   const bool keep = m.factor_ok && m.reuse.max_iterations > 0 && m.spare_wanted;
   if (keep && !m.spare) {
+    CholmodSerialScope serial;
     m.spare = cholmod_l_copy_factor(m.L, &m.c);
     if (!m.spare) throw SolverError("Cholmod factor copy failed: " + status_name(m.c.status));
   }
   cholmod_factor* target = keep ? m.spare : m.L;
   if (!keep) m.factor_ok = false;
-  if (!cholmod_l_factorize(&S, target, &m.c) || m.c.status != CHOLMOD_OK) {
+  bool factorised;
+  {
+    CholmodSerialScope serial;
+    factorised = cholmod_l_factorize(&S, target, &m.c);
+  }
+  if (!factorised || m.c.status != CHOLMOD_OK) {
     if (m.c.status == CHOLMOD_NOT_POSDEF) {
       m.spare_wanted = true;
       throw NotPositiveDefinite("Cholmod factorisation failed: " + status_name(m.c.status));
@@ -240,8 +248,12 @@ CholmodDirect::Result CholmodDirect::solve(const Vector& b, Vector& x) {
   m.factor_ok = true;
   auto bv = b.getLocalViewDevice(Tpetra::Access::ReadOnly);
   cholmod_dense B = dense_column_view(const_cast<double*>(bv.data()), S.nrow);
-  if (!cholmod_l_solve2(CHOLMOD_A, m.L, &B, nullptr, &m.X, nullptr, &m.Y, &m.E, &m.c) || m.c.status != CHOLMOD_OK)
-    throw SolverError("Cholmod solve failed: " + status_name(m.c.status));
+  bool solved;
+  {
+    CholmodSerialScope serial;
+    solved = cholmod_l_solve2(CHOLMOD_A, m.L, &B, nullptr, &m.X, nullptr, &m.Y, &m.E, &m.c);
+  }
+  if (!solved || m.c.status != CHOLMOD_OK) throw SolverError("Cholmod solve failed: " + status_name(m.c.status));
   auto xv = x.getLocalViewDevice(Tpetra::Access::OverwriteAll);
   std::memcpy(xv.data(), m.X->x, S.nrow * sizeof(double));
   return res;

@@ -2,7 +2,8 @@
 // spatial hash's pair list equals a brute-force O(n m) reference (computed
 // here only) on random scenes mixing small, zero-size and scene-spanning boxes,
 // exactly touching boxes and boxes on a coarse binary lattice; no duplicates;
-// sorted by (query, box); repeated queries and rebuilds after moving boxes give
+// sorted by (query, box), also above the size where the hash is built in
+// parallel; repeated queries and rebuilds after moving boxes give
 // the reference again without reallocating; empty inputs; memory stays bounded
 // for huge boxes; point_boxes / simplex_boxes against host formulas; and
 // point_in_simplex on inside, outside, edge, vertex and near points.
@@ -133,14 +134,14 @@ using Dims = ::testing::Types<std::integral_constant<int, 2>, std::integral_cons
 TYPED_TEST_SUITE(BroadPhase, Dims);
 
 template <int dim>
-void check_scene(bool lattice, unsigned seed) {
-  const auto boxes = random_boxes<dim>(2000, seed, lattice);
+void check_scene(bool lattice, unsigned seed, int n_boxes = 2000) {
+  const auto boxes = random_boxes<dim>(n_boxes, seed, lattice);
   const auto queries = random_queries<dim>(500, boxes, seed + 1, lattice);
   SpatialHash<dim> hash;
   hash.build(to_device(boxes));
   Kokkos::View<LO* [2], MemSpace> pairs;
   const PairList ref = brute_force(queries, boxes);
-  ASSERT_GT(ref.size(), 2000u);  // the covering query alone hits every box
+  ASSERT_GT(ref.size(), static_cast<std::size_t>(n_boxes));  // the covering query alone hits every box
   expect_same(hash_pairs(hash, queries, pairs), ref);
   EXPECT_LE(hash.stats().oversize, SpatialHash<dim>::kMaxOversize);
   EXPECT_LE(hash.stats().entries, SpatialHash<dim>::kEntriesPerBox * boxes.size());
@@ -148,6 +149,12 @@ void check_scene(bool lattice, unsigned seed) {
 }
 
 TYPED_TEST(BroadPhase, MatchesBruteForce) { check_scene<TypeParam::value>(false, 11); }
+// Below kSerialBelow boxes the hash is built on the calling thread
+// (kernels/small_loops.hpp); this scene is built with ExecSpace's parallel
+// loops (atomic bucket counts and fills, parallel scans).
+TYPED_TEST(BroadPhase, MatchesBruteForceAboveTheSerialThreshold) {
+  check_scene<TypeParam::value>(false, 31, static_cast<int>(kSerialBelow) + 1000);
+}
 
 TYPED_TEST(BroadPhase, MatchesBruteForceOnLatticeWithTouchingBoxes) { check_scene<TypeParam::value>(true, 23); }
 

@@ -117,6 +117,23 @@ TEST(SmallLoops, TheCallersThresholdChoosesTheSpace) {
     } else if (ExecSpace().concurrency() > 1) {
       EXPECT_EQ(sum, 0) << "serial_below = " << below;
     }
+    long scanned = 0;
+    small_scan(
+        "threshold_scan", n,
+        KOKKOS_LAMBDA(const long i, long& off, const bool final) {
+          if (final) inside(i) = omp_in_parallel() ? 1 : 0;
+          off += i;
+        },
+        scanned, below);
+    Kokkos::fence();
+    parallel = 0;
+    for (long i = 0; i < n; ++i) parallel += inside(i);
+    EXPECT_EQ(scanned, n * (n - 1) / 2) << "serial_below = " << below;
+    if (n < below) {
+      EXPECT_EQ(parallel, 0) << "serial_below = " << below;
+    } else if (ExecSpace().concurrency() > 1) {
+      EXPECT_EQ(parallel, n) << "serial_below = " << below;
+    }
   }
 }
 
