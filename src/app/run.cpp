@@ -152,6 +152,9 @@ void accumulate(RunSummary& s, const StepReport& r) {
   s.contact_ccd_s += r.contact_ccd_s;
   s.symbolic_factorizations += r.newton.symbolic_factorizations;
   s.numeric_factorizations += r.newton.numeric_factorizations;
+  s.factor_s += r.newton.factor_s;
+  s.reuse_cg_s += r.newton.reuse_cg_s;
+  s.reuse_cg_iterations += r.newton.reuse_cg_iterations;
   s.stale_retries += r.newton.stale_retries;
   s.projected_retries += r.newton.projected_retries;
   s.exact_hessian_iterations += r.newton.exact_hessian_iterations;
@@ -188,7 +191,8 @@ RunSummary run_dim(const Scene& scene, const std::string& dir, const Teuchos::RC
       << mesh.num_nodes() * dim << " DOFs";
   if (const auto* mpm = sim.mpm())
     log << "; MPM: " << mpm->total_particles() << " particles, " << transfer_scheme_name(mpm->scheme())
-        << ", grid " << mpm->grid().num_nodes() << " nodes (dx " << mpm->grid().dx << ")";
+        << ", grid " << mpm->grid().num_nodes() << " nodes (dx " << mpm->grid().dx << ")"
+        << (mpm->sort_every() > 0 ? ", sorted by cell every " + std::to_string(mpm->sort_every()) + " steps" : "");
   log << "; linear solver: " << sim.newton().linear_solver().describe() << "\n";
   if (const FemPartition* part = sim.partition()) {
     // Per-rank work: elements (assembly) and owned DOFs (solve); imbalance = max / mean.
@@ -251,7 +255,7 @@ RunSummary run_dim(const Scene& scene, const std::string& dir, const Teuchos::RC
   auto write_frame = [&] {  // collective
     output_timer.reset();
     const auto* mpm = sim.mpm();
-    if (!mpm || !mpm->distributed()) {
+    if (!mpm || mpm->particles_in_id_order()) {
       out.write_frame(sim);
       s.output_s += output_timer.seconds();
       return;
@@ -332,6 +336,10 @@ RunSummary run_dim(const Scene& scene, const std::string& dir, const Teuchos::RC
     s.output_s = most[2];
     s.exchange_mb = most[3];
     s.graph_build_s = most[4];
+  }
+  if (const auto* mpm = sim.mpm()) {
+    s.particle_sorts = mpm->particle_sorts();
+    s.sort_every = mpm->sort_every();
   }
   if (const auto* mpm = sim.mpm(); mpm && mpm->distributed()) {
     s.mpm_ranks = comm->getSize();
@@ -417,6 +425,9 @@ RunSummary run_scene(const Scene& scene, const std::string& dir, const Teuchos::
         << " Newton iterations (the others: CG on the previous factor)"
         << (s.stale_retries > 0 ? "; " + std::to_string(s.stale_retries) + " solve(s) redone on a fresh factor" : std::string())
         << "\n";
+  if (s.factor_s + s.reuse_cg_s > 0)
+    log << "    of the solve time " << s.factor_s << " s analysis + factorisation, " << s.reuse_cg_s << " s in "
+        << s.reuse_cg_iterations << " CG iterations on the previous factor\n";
   if (s.exact_hessian_iterations + s.projection_fallbacks > 0)
     log << "  exact Hessian       " << s.exact_hessian_iterations << " of " << s.newton_iterations
         << " iterations (" << s.projection_fallbacks << " not positive definite: projected";
@@ -434,6 +445,8 @@ RunSummary run_scene(const Scene& scene, const std::string& dir, const Teuchos::
   if (s.contact)
     log << "  contact: broad phase " << s.contact_broad_phase_s << " s, pair evaluation " << s.contact_eval_s
         << " s, CCD " << s.contact_ccd_s << " s (within the times above)\n";
+  if (s.sort_every > 0)
+    log << "  particle sorts      " << s.particle_sorts << " (by grid cell, every " << s.sort_every << " steps)\n";
   if (s.mpm_ranks > 1)
     log << "  MPM on " << s.mpm_ranks << " ranks      " << s.migrations << " particle migrations, " << s.rebalances
         << " slab rebalance(s); particle imbalance at the end " << std::setprecision(3) << s.imbalance

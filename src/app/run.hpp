@@ -32,6 +32,8 @@ struct RunSummary {
   double exchange_mb = 0;  // MB the busiest rank sent in the DOF exchanges
   double graph_build_s = 0;  // DofSpace graph builds (the slowest rank)
   long graph_builds = 0, symbolic_factorizations = 0, numeric_factorizations = 0;
+  double factor_s = 0, reuse_cg_s = 0;  // Cholmod (within solve_s)
+  long reuse_cg_iterations = 0;
   long stale_retries = 0;  // CG + BLOCK_CHOLMOD solves redone after the kept factor failed
   std::vector<std::pair<std::string, long>> graph_build_causes;  // DofSpace::build_causes (rank 0's)
   long projected_retries = 0;  // steps redone with the projected Hessian
@@ -45,6 +47,7 @@ struct RunSummary {
   int ranks = 1;  // MPI ranks of the run
   long long migrations = 0;
   double imbalance = 1.0;
+  int particle_sorts = 0, sort_every = 0;  // MPM/sort particles every
 };
 
 struct RunOptions {

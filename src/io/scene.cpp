@@ -194,6 +194,7 @@ void build_mpm(const Scene& scene, const std::vector<std::string>& mat_names, Si
   mpm.scheme = tr == "PIC" ? TransferScheme::PIC : tr == "FLIP" ? TransferScheme::FLIP : TransferScheme::APIC;
   mpm.extend_domain = m.get<std::string>("when particles leave") == "extend";
   mpm.rebalance_above = m.get<double>("rebalance above");
+  mpm.sort_every = m.get<int>("sort particles every");
   try {
     mpm.grid = grid_covering<dim>(vecd<dim>(m.get<Array<double>>("domain min"), "MPM/domain min"),
                                   vecd<dim>(m.get<Array<double>>("domain max"), "MPM/domain max"), dx);

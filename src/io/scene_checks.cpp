@@ -107,6 +107,8 @@ void check_mpm(const ParameterList& raw, int dim) {
   const double rb = m.get<double>("rebalance above");
   if (!(rb == 0 || (rb > 1 && std::isfinite(rb))))
     bad("MPM/rebalance above", num(rb), "0 (never) or a finite imbalance > 1 (largest / mean particles per rank)");
+  const int se = m.get<int>("sort particles every");
+  if (se < 0) bad("MPM/sort particles every", std::to_string(se), "0 (never) or a number of steps >= 1");
 }
 
 void check_contact(const ParameterList& raw) {

@@ -199,6 +199,9 @@ Teuchos::RCP<const ParameterList> scene_schema() {
   mpm.set("rebalance above", 1.2,
           "MPI: new slab cuts when the ranks' particle counts reach largest / mean > this after a step "
           "(0: never; else > 1)");
+  mpm.set("sort particles every", 0,
+          "steps between reorders of the particles by grid cell, from step 1 (locality of the transfers and "
+          "the assembly; the same run to round-off); 0: never; >= 0");
   pl->sublist("MPM Bodies", false, "named MPM bodies (particles)").disableRecursiveValidation();
   auto& ex = pl->sublist("Explicit", false, "explicit multimaterial MPM (Solver: explicit; paper 001)");
   choice(ex, "shape functions", "uGIMP", "grid shape functions", tuple<std::string>("uGIMP", "quadratic B-spline"));

@@ -116,6 +116,12 @@ void MpmBodies<dim>::replace_particles(const Particles<dim>& all) {
   n_total_ = static_cast<long long>(all.size());
   if (!distributed_) {
     setup_.particles = all;
+    if (ids_.extent(0) != all.size()) ids_ = Kokkos::View<long long*, MemSpace>("mpm_particle_ids", all.size());
+    auto ids = ids_;
+    Kokkos::parallel_for(
+        "mpm_ids", Kokkos::RangePolicy<ExecSpace>(0, all.size()), KOKKOS_LAMBDA(const std::size_t q) { ids(q) = q; });
+    sorted_ = false;
+    resize_stencils();
     return;
   }
   slabs_ = balanced_slabs(all, setup_.grid, comm_->getSize());
@@ -161,7 +167,7 @@ long long MpmBodies<dim>::rebalance(long long largest_count) {
 
 template <int dim>
 Particles<dim> MpmBodies<dim>::gathered_particles() const {
-  if (!distributed_) return setup_.particles;
+  if (!distributed_) return sorted_ ? particles_by_id(setup_.particles, ids_) : setup_.particles;
   return gather_particles(setup_.particles, ids_, n_total_, *comm_);
 }
 
@@ -299,8 +305,26 @@ void MpmBodies<dim>::sum_shared_nodes() {
 }
 
 template <int dim>
+void MpmBodies<dim>::sort_by_cell() {
+  // One rank: first back into id order, so that the order within a cell (by
+  // index, bin_particles) is by id and the sorted order depends on the
+  // positions alone: a restarted run sorts as the uninterrupted one did.
+  if (!distributed_ && sorted_) {
+    setup_.particles = particles_by_id(setup_.particles, ids_);
+    auto ids = ids_;
+    Kokkos::parallel_for(
+        "mpm_ids", Kokkos::RangePolicy<ExecSpace>(0, ids.extent(0)), KOKKOS_LAMBDA(const std::size_t q) { ids(q) = q; });
+  }
+  bin_particles(setup_.grid, setup_.particles, cells_);
+  permute_particles(setup_.particles, ids_, Kokkos::View<const LO*, MemSpace>(cells_.order));
+  sorted_ = true;
+  ++sorts_;
+}
+
+template <int dim>
 LO MpmBodies<dim>::begin_step(LO first, long step) {
   check_inside_grid(step);
+  if (setup_.sort_every > 0 && (step - 1) % setup_.sort_every == 0) sort_by_cell();
   resize_stencils();
   const auto& grid = setup_.grid;
   const auto& p = setup_.particles;

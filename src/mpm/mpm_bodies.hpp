@@ -43,6 +43,12 @@ struct MpmSetup {
   // more than rebalance_above x the mean particle count (0: never; scene key
   // 'MPM/rebalance above').
   double rebalance_above = 1.2;
+  // Particles reordered by cell (the base node of their B-spline stencil,
+  // x fastest; within a cell by id on one rank) at the start of steps 1,
+  // 1 + sort_every, 1 + 2 sort_every, ..., so that neighbouring particles
+  // touch neighbouring grid rows (0: never; scene key 'MPM/sort particles
+  // every'). The run is the same to round-off (summation orders change).
+  int sort_every = 0;
 };
 
 // MPM elasticity: deformation stencils of the particles; the graph couplings
@@ -118,6 +124,10 @@ class MpmBodies {
   double imbalance() const { return imbalance_; }
   // Particles on all ranks; each particle's global id (its scene index).
   long long total_particles() const { return n_total_; }
+  // One rank, never sorted: particle q has id q (outputs may skip the ids).
+  bool particles_in_id_order() const { return !distributed_ && !sorted_; }
+  int particle_sorts() const { return sorts_; }  // on this rank, since construction
+  int sort_every() const { return setup_.sort_every; }
   Kokkos::View<const long long*, MemSpace> particle_ids() const { return ids_; }
   // All particles in id order on rank 0 (collective; empty elsewhere; the
   // rank's own set on one rank, without a copy).
@@ -172,6 +182,9 @@ class MpmBodies {
   ParticleSlabs<dim> slabs_;
   Kokkos::View<long long*, MemSpace> ids_;
   long long n_total_ = 0, migrated_ = 0;
+  bool sorted_ = false;  // reordered by cell since construction or replace_particles
+  int sorts_ = 0;
+  void sort_by_cell();
   double migration_s_ = 0;
   int rebalances_ = 0;
   double imbalance_ = 1.0, retry_above_ = 0.0;  // retry_above_: a failed rebalance waits for more imbalance

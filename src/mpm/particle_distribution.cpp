@@ -365,6 +365,36 @@ Particles<dim> particles_in_id_block(const Particles<dim>& p, Kokkos::View<const
   return out;
 }
 
+template <int dim>
+Particles<dim> particles_by_id(const Particles<dim>& p, Kokkos::View<const long long*, MemSpace> ids) {
+  const LO np = static_cast<LO>(p.size());
+  if (static_cast<LO>(ids.extent(0)) != np) throw std::logic_error("particles_by_id: one id per particle expected");
+  Kokkos::View<LO*, MemSpace> order("mpm_by_id_order", np);
+  Kokkos::parallel_for(
+      "mpm_by_id_identity", Kokkos::RangePolicy<ExecSpace>(0, np), KOKKOS_LAMBDA(const LO q) { order(q) = q; });
+  Buffer buf("mpm_by_id_buffer", np, kFields<dim>);
+  pack<dim>(p, ids, order, buf);
+  Particles<dim> out = allocate_particles<dim>(np);
+  unpack<dim>(buf, np, out, Kokkos::View<long long*, MemSpace>(), 0, true);
+  Kokkos::fence();
+  return out;
+}
+
+template <int dim>
+void permute_particles(Particles<dim>& p, Kokkos::View<long long*, MemSpace>& ids, Kokkos::View<const LO*, MemSpace> order) {
+  const std::size_t np = p.size();
+  if (order.extent(0) != np || ids.extent(0) != np)
+    throw std::logic_error("permute_particles: one order entry and one id per particle expected");
+  Buffer buf("mpm_permute_buffer", np, kFields<dim>);
+  pack<dim>(p, ids, order, buf);
+  Particles<dim> out = allocate_particles<dim>(np);
+  Kokkos::View<long long*, MemSpace> out_ids("mpm_particle_ids", np);
+  unpack<dim>(buf, np, out, out_ids, 0, false);
+  Kokkos::fence();
+  p = out;
+  ids = out_ids;
+}
+
 Kokkos::View<double*, MemSpace> particle_values_in_id_block(Kokkos::View<const double*, MemSpace> values, int k,
                                                             Kokkos::View<const long long*, MemSpace> ids,
                                                             long long n_total, const Teuchos::Comm<int>& comm) {
@@ -413,7 +443,10 @@ Kokkos::View<double*, MemSpace> particle_values_in_id_block(Kokkos::View<const d
   template Particles<D> gather_particles<D>(const Particles<D>&, Kokkos::View<const long long*, MemSpace>, long long, \
                                             const Teuchos::Comm<int>&, int);                                        \
   template Particles<D> particles_in_id_block<D>(const Particles<D>&, Kokkos::View<const long long*, MemSpace>,     \
-                                                 long long, const Teuchos::Comm<int>&);
+                                                 long long, const Teuchos::Comm<int>&);                               \
+  template Particles<D> particles_by_id<D>(const Particles<D>&, Kokkos::View<const long long*, MemSpace>);           \
+  template void permute_particles<D>(Particles<D>&, Kokkos::View<long long*, MemSpace>&,                            \
+                                     Kokkos::View<const LO*, MemSpace>);
 BFEMP_INSTANTIATE(2)
 BFEMP_INSTANTIATE(3)
 #undef BFEMP_INSTANTIATE

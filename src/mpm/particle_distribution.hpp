@@ -77,6 +77,19 @@ template <int dim>
 Particles<dim> gather_particles(const Particles<dim>& p, Kokkos::View<const long long*, MemSpace> ids,
                                 long long n_total, const Teuchos::Comm<int>& comm, int root = 0);
 
+// Local reorders of this rank's particles (no communication), for the
+// periodic sort by cell (MpmBodies, 'MPM/sort particles every'):
+//  - particles_by_id: a copy with particle q at row ids(q) (ids must be a
+//    permutation of 0..np-1: one rank, every particle here);
+//  - permute_particles: p and ids replaced by their rows order(0), order(1),
+//    ... (order a permutation of 0..np-1).
+// Both pass every field once through a packed buffer (allocated per call).
+template <int dim>
+Particles<dim> particles_by_id(const Particles<dim>& p, Kokkos::View<const long long*, MemSpace> ids);
+template <int dim>
+void permute_particles(Particles<dim>& p, Kokkos::View<long long*, MemSpace>& ids,
+                       Kokkos::View<const LO*, MemSpace> order);
+
 // The output blocks: rank r of R holds the particles with ids in
 // [id_block_begin(n, r, R), id_block_begin(n, r + 1, R)).
 KOKKOS_INLINE_FUNCTION long long id_block_begin(long long n_total, int rank, int nranks) {

@@ -482,10 +482,11 @@ StepReport Simulation<dim>::step() {
   if (graph_rebuilt) ++ns.graph_builds;
   typename Contact<dim>::Report contact_report;
   if (contact_) contact_report = contact_->report(x, nF);
-  if (contact_ && mpm_distributed_) {
-    reduce_report(contact_report);
+  if (contact_ && mpm_distributed_) reduce_report(contact_report);
+  if (contact_ && mpm_ && !mpm_->particles_in_id_order()) {
     // The particle contact forces follow this step's particle order, which
-    // migration below changes: keep their ids for the output.
+    // migration below (and the next step's sort) changes: keep their ids
+    // for the output.
     const auto ids = mpm_->particle_ids();
     if (force_ids_.extent(0) != ids.extent(0)) force_ids_ = Kokkos::View<long long*, MemSpace>("contact_force_ids", ids.extent(0));
     Kokkos::deep_copy(force_ids_, ids);
@@ -634,6 +635,9 @@ NewtonStats Simulation<dim>::minimize_with_friction(const IncrementalPotential& 
     total.graph_builds += st.graph_builds;
     total.symbolic_factorizations += st.symbolic_factorizations;
     total.numeric_factorizations += st.numeric_factorizations;
+    total.factor_s += st.factor_s;
+    total.reuse_cg_s += st.reuse_cg_s;
+    total.reuse_cg_iterations += st.reuse_cg_iterations;
     total.stale_retries += st.stale_retries;
     total.exact_hessian_iterations += st.exact_hessian_iterations;
     total.projection_fallbacks += st.projection_fallbacks;

@@ -194,8 +194,10 @@ CholmodDirect::Result CholmodDirect::solve(const Vector& b, Vector& x) {
   if (m.A.is_null()) throw std::logic_error("CholmodDirect::solve before set_matrix");
   Result res;
   if (m.factor_ok && m.reuse.max_iterations > 0) {
+    Kokkos::Timer cg_timer;
     const bool ok = cg_on_old_factor(m.reuse, m.c, m.L, m.X, m.Y, m.E, *m.A, b, m.cg_x, m.cg_r, m.cg_z, m.cg_p,
                                      m.cg_q, res.cg_iterations);
+    res.cg_s = cg_timer.seconds();
     if (ok) {
       auto xv = x.getLocalViewDevice(Tpetra::Access::OverwriteAll);
       const auto cx = m.cg_x;
@@ -206,6 +208,7 @@ CholmodDirect::Result CholmodDirect::solve(const Vector& b, Vector& x) {
     }
   }
   cholmod_sparse S = m.view();
+  Kokkos::Timer factor_timer;
   bool analysed_now = false;
   if (!m.analysed) {
     {
@@ -246,6 +249,7 @@ CholmodDirect::Result CholmodDirect::solve(const Vector& b, Vector& x) {
   }
   if (keep) std::swap(m.L, m.spare);
   m.factor_ok = true;
+  res.factor_s = factor_timer.seconds();
   auto bv = b.getLocalViewDevice(Tpetra::Access::ReadOnly);
   cholmod_dense B = dense_column_view(const_cast<double*>(bv.data()), S.nrow);
   bool solved;

@@ -55,6 +55,8 @@ class CholmodDirect {
     bool analysed = false;    // the symbolic analysis ran in this call
     bool factorised = false;  // the numeric factorisation ran in this call
     int cg_iterations = 0;    // CG iterations on the previous factor (also when CG gave up)
+    double factor_s = 0;      // seconds in the symbolic analysis and numeric factorisation
+    double cg_s = 0;          // seconds in CG on the previous factor (also when it gave up)
   };
 
   explicit CholmodDirect(Reuse reuse = {});

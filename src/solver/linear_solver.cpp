@@ -359,6 +359,8 @@ LinearSolveStats LinearSolver::solve(const Vector& b, Vector& x, double forcing)
         stats.refactored = r.analysed;
         stats.factorised = r.factorised;
         stats.iterations = r.cg_iterations + (r.factorised ? 1 : 0);
+        stats.factor_s = r.factor_s;
+        stats.reuse_cg_s = r.cg_s;
       } else {
         stats.factorised = true;
         stats.iterations = 1;

@@ -21,6 +21,8 @@ struct LinearSolveStats {
   bool refactored = false;   // a symbolic factorisation happened in this call
   bool factorised = false;   // a numeric factorisation happened in this call (direct solvers)
   double tolerance = 0;      // relative residual the solve was asked for (0: direct)
+  double factor_s = 0;       // Cholmod: seconds in analysis + numeric factorisation
+  double reuse_cg_s = 0;     // Cholmod: seconds in CG on the previous factor
   int stale_retries = 0;     // CG + BLOCK_CHOLMOD: solves that did not converge on the
                              // kept (stale) factor and were redone on a fresh one
 };

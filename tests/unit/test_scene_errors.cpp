@@ -189,6 +189,8 @@ bfemp:
   for (const char* v : {"1", "0.5", "-1"})
     expect_message(error_of(with("particles per cell: 4", std::string("particles per cell: 4\n    rebalance above: ") + v)),
                    {"MPM/rebalance above", v, "0 (never) or a finite imbalance > 1"});
+  expect_message(error_of(with("particles per cell: 4", "particles per cell: 4\n    sort particles every: -2")),
+                 {"MPM/sort particles every", "-2", "0 (never) or a number of steps >= 1"});
   expect_message(error_of(with("domain max: [1.0, 1.0]", "domain max: [1.0]")), {"MPM/domain max", "2 components"});
   expect_message(error_of(with("shape: box", "shape: blob")), {"MPM Bodies/block/shape", "blob"});
 }
