@@ -84,6 +84,7 @@ Checkpoint make_checkpoint(const Scene& scene, const RunOptions& opt, const Simu
     c.put("particle_C", st.C, dim * dim);
     c.put("particle_body", st.body);
     c.put("particle_material", st.material);
+    if (!st.particle_order.empty()) c.put("particle_order", st.particle_order);
     c.put("grid_origin", std::vector<double>(st.grid_origin.begin(), st.grid_origin.end()));
     c.put("grid_cells", std::vector<long long>(st.grid_cells.begin(), st.grid_cells.end()));
     c.put("grid_dx", std::vector<double>{st.grid_dx});
@@ -128,6 +129,7 @@ SimulationState<dim> checkpoint_state(const Checkpoint& c) {
     st.C = c.real("particle_C");
     st.body = c.ints("particle_body");
     st.material = c.ints("particle_material");
+    if (c.has("particle_order")) st.particle_order = c.ints("particle_order");
     const auto& o = c.real("grid_origin", dim);
     const auto& n = c.ints("grid_cells", dim);
     for (int d = 0; d < dim; ++d) {

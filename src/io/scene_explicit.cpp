@@ -103,6 +103,9 @@ void check_solver_keys(ParameterList& raw) {
     }
     if (raw.isSublist("MPM") && raw.sublist("MPM").isParameter("transfer"))
       bad("MPM/transfer", "(given)", "no implicit-only key in an explicit scene (use Explicit/update)");
+    if (raw.isSublist("MPM") && raw.sublist("MPM").isParameter("sort particles every"))
+      bad("MPM/sort particles every", "(given)", "no implicit-only key in an explicit scene (the explicit stepper "
+                                                 "bins its particles by cell each step)");
     return;
   }
   if (raw.isParameter("Explicit")) bad("Explicit", "(given)", "'Solver: explicit' for the Explicit keys");

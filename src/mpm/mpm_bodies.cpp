@@ -130,6 +130,27 @@ void MpmBodies<dim>::replace_particles(const Particles<dim>& all) {
 }
 
 template <int dim>
+void MpmBodies<dim>::restore_order(const std::vector<long long>& order) {
+  const std::size_t np = setup_.particles.size();
+  if (distributed_) throw std::logic_error("MpmBodies::restore_order on several ranks");
+  std::vector<char> seen(np, 0);
+  bool ok = order.size() == np;
+  for (std::size_t k = 0; ok && k < np; ++k) {
+    ok = order[k] >= 0 && order[k] < static_cast<long long>(np) && !seen[order[k]];
+    if (ok) seen[order[k]] = 1;
+  }
+  if (!ok)
+    throw std::invalid_argument("restart: checkpoint field 'particle_order' (" + std::to_string(order.size()) +
+                                " values) is not a permutation of the " + std::to_string(np) + " particles");
+  Kokkos::View<LO*, Kokkos::HostSpace> h("mpm_restored_order", np);
+  for (std::size_t k = 0; k < np; ++k) h(k) = static_cast<LO>(order[k]);
+  auto d = Kokkos::create_mirror_view_and_copy(MemSpace(), h);
+  // ids are 0..n-1 after replace_particles: row k gets particle order[k].
+  permute_particles(setup_.particles, ids_, Kokkos::View<const LO*, MemSpace>(d));
+  sorted_ = true;
+}
+
+template <int dim>
 long long MpmBodies<dim>::migrate() {
   if (!distributed_) return 0;
   Kokkos::Timer timer;

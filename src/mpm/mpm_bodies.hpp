@@ -47,7 +47,9 @@ struct MpmSetup {
   // x fastest; within a cell by id on one rank) at the start of steps 1,
   // 1 + sort_every, 1 + 2 sort_every, ..., so that neighbouring particles
   // touch neighbouring grid rows (0: never; scene key 'MPM/sort particles
-  // every'). The run is the same to round-off (summation orders change).
+  // every'). The run is the same to round-off (summation orders change). In
+  // contact a sort renames the barrier's pairs (keyed by particle index):
+  // the Newton graph is rebuilt at that step.
   int sort_every = 0;
 };
 
@@ -108,6 +110,10 @@ class MpmBodies {
   bool distributed() const { return distributed_; }
   // Restart: the whole particle set of a checkpoint (re-cut when distributed).
   void replace_particles(const Particles<dim>& all);
+  // Restart on one rank, after replace_particles: the checkpoint's particle
+  // order (the id at each array position; std::invalid_argument unless it is
+  // a permutation of 0..n-1).
+  void restore_order(const std::vector<long long>& order);
   // Particles that left this rank's slab go to their owners (collective; at
   // the end of a step); then, when the slabs' counts differ more than
   // rebalance_above allows, new cuts (rebalanced_slabs) and a second exchange.
@@ -129,8 +135,8 @@ class MpmBodies {
   int particle_sorts() const { return sorts_; }  // on this rank, since construction
   int sort_every() const { return setup_.sort_every; }
   Kokkos::View<const long long*, MemSpace> particle_ids() const { return ids_; }
-  // All particles in id order on rank 0 (collective; empty elsewhere; the
-  // rank's own set on one rank, without a copy).
+  // All particles in id order on rank 0 (collective; empty elsewhere; on one
+  // rank the particles themselves, or a copy in id order when sorted).
   Particles<dim> gathered_particles() const;
   // Active nodes owned by this rank (the first ones) and the global system
   // id of every active node (distributed; empty on one rank).

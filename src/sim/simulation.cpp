@@ -201,7 +201,9 @@ Simulation<dim>::Simulation(SimulationSetup<dim> setup, const Teuchos::RCP<const
                             " is inside or on an FEM body at a Newton iterate (Contact/check iterates)");
         }
         if (q < 0) return;
-        throw SolverError((q < np ? "MPM particle " + std::to_string(q)
+        long long id = q;  // sorted particles: name the particle by its id
+        if (q < np && !mpm_->particles_in_id_order()) Kokkos::deep_copy(id, Kokkos::subview(mpm_->particle_ids(), q));
+        throw SolverError((q < np ? "MPM particle " + std::to_string(id)
                                   : "FEM boundary node (contact point " + std::to_string(q - np) + ")") +
                           " is inside or on an FEM body at a Newton iterate (Contact/check iterates)");
       };

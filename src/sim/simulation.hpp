@@ -91,6 +91,10 @@ struct SimulationState {
   bool has_mpm = false;
   std::vector<double> x, v, mass, volume0, F, C;
   std::vector<long long> body, material;
+  // One rank, particles sorted by cell ('MPM/sort particles every'): the id
+  // at each array position, so that a restart continues in the same order
+  // (empty: id order; never written on several ranks).
+  std::vector<long long> particle_order;
   std::array<double, dim> grid_origin{};
   std::array<int, dim> grid_cells{};
   double grid_dx = 0;

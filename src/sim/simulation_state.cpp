@@ -63,6 +63,10 @@ SimulationState<dim> Simulation<dim>::state() const {
     }
     s.grid_dx = g.dx;
     s.grid_extensions = mpm_->domain_extensions();
+    if (!mpm_->distributed() && !mpm_->particles_in_id_order()) {
+      auto ids = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), mpm_->particle_ids());
+      s.particle_order.assign(ids.data(), ids.data() + ids.extent(0));
+    }
   }
   return s;
 }
@@ -100,6 +104,7 @@ void Simulation<dim>::restore(const SimulationState<dim>& s) {
     g.dx = s.grid_dx;
     mpm_->restore_grid(g, s.grid_extensions);
     mpm_->replace_particles(p);  // (MPI: slabs cut on the checkpoint's grid)
+    if (!s.particle_order.empty() && !mpm_->distributed()) mpm_->restore_order(s.particle_order);
   }
   time_ = s.time;
   step_ = s.step;

@@ -3,6 +3,7 @@
 #include <Tpetra_CrsMatrix.hpp>
 #include <Tpetra_Vector.hpp>
 #include <cholmod.h>
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <string>
@@ -46,6 +47,7 @@ struct CholmodDirect::Impl {
   bool factor_ok = false;  // L holds a complete numeric factor of this graph
   bool spare_wanted = false;  // a non-positive pivot was met in this step: keep L while refactorising
   Reuse reuse;
+  int budget = 0;  // CG iterations allowed on the previous factor (reuse.max_iterations, or by cost)
   using V = Kokkos::View<double*, MemSpace>;
   V cg_x, cg_r, cg_z, cg_p, cg_q;  // CG work, sized once per graph
 
@@ -195,7 +197,10 @@ CholmodDirect::Result CholmodDirect::solve(const Vector& b, Vector& x) {
   Result res;
   if (m.factor_ok && m.reuse.max_iterations > 0) {
     Kokkos::Timer cg_timer;
-    const bool ok = cg_on_old_factor(m.reuse, m.c, m.L, m.X, m.Y, m.E, *m.A, b, m.cg_x, m.cg_r, m.cg_z, m.cg_p,
+    Reuse r = m.reuse;
+    r.max_iterations = m.budget;
+    res.cg_budget = m.budget;
+    const bool ok = cg_on_old_factor(r, m.c, m.L, m.X, m.Y, m.E, *m.A, b, m.cg_x, m.cg_r, m.cg_z, m.cg_p,
                                      m.cg_q, res.cg_iterations);
     res.cg_s = cg_timer.seconds();
     if (ok) {
@@ -219,6 +224,12 @@ CholmodDirect::Result CholmodDirect::solve(const Vector& b, Vector& x) {
       throw SolverError("Cholmod analysis failed: " + status_name(m.c.status));
     m.analysed = true;
     analysed_now = true;
+    m.budget = m.reuse.max_iterations;
+    if (m.reuse.by_cost && m.reuse.max_iterations > 0 && m.L->is_super) {  // (a simplicial factor: no BLAS 3)
+      const double per_iteration = 4.0 * static_cast<double>(m.L->xsize) + 2.0 * static_cast<double>(m.i.size());
+      const double by_cost = std::min<double>(Reuse::kMaxByCost, m.c.fl / (Reuse::kBlas3Advantage * per_iteration));
+      m.budget = std::max(m.budget, static_cast<int>(by_cost));
+    }
   }
   res.analysed = analysed_now;
   res.factorised = true;

@@ -23,6 +23,7 @@ struct LinearSolveStats {
   double tolerance = 0;      // relative residual the solve was asked for (0: direct)
   double factor_s = 0;       // Cholmod: seconds in analysis + numeric factorisation
   double reuse_cg_s = 0;     // Cholmod: seconds in CG on the previous factor
+  int reuse_cg_iterations = 0;  // Cholmod: CG iterations on the previous factor
   int stale_retries = 0;     // CG + BLOCK_CHOLMOD: solves that did not converge on the
                              // kept (stale) factor and were redone on a fresh one
 };

@@ -378,7 +378,7 @@ NewtonStats NewtonSolver<dim>::minimize(const IncrementalPotential& ip, View1 x)
     if (ls.factorised) ++st.numeric_factorizations;
     st.factor_s += ls.factor_s;
     st.reuse_cg_s += ls.reuse_cg_s;
-    st.reuse_cg_iterations += ls.iterations - (ls.factorised ? 1 : 0);
+    st.reuse_cg_iterations += ls.reuse_cg_iterations;
     st.stale_retries += ls.stale_retries;
     m.dofs.to_local(*m.p, dir);
     st.solve_s += timer.seconds();

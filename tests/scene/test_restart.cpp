@@ -324,6 +324,16 @@ TEST(Restart, SortedParticlesContinueBitForBit) {
   restart_equals_uninterrupted({"contact_sorted", disk_wall, friction_sets + " --set 'MPM/sort particles every=3'", 1e-3, 6});
   const std::string log = slurp(dir_of("contact_sorted_full") + ".log");
   EXPECT_NE(log.find("particle sorts      4 (by grid cell, every 3 steps)"), std::string::npos) << log;
+  // A checkpoint between sorts (steps 1 and 5 sort, the restart is at 6):
+  // the checkpoint carries the order of step 5's sort, and the restarted
+  // run continues in it until step 9 sorts again.
+  const bfemp::Checkpoint mid =
+      restart_equals_uninterrupted({"contact_sorted4", disk_wall, friction_sets + " --set 'MPM/sort particles every=4'", 1e-3, 6});
+  ASSERT_TRUE(mid.has("particle_order"));
+  const auto& order = mid.ints("particle_order");
+  long moved = 0;
+  for (std::size_t k = 0; k < order.size(); ++k) moved += order[k] != static_cast<long long>(k);
+  EXPECT_GT(moved, 0) << "the sort must have reordered the particles";
 }
 
 // Sorted and unsorted particle order give the same run to round-off: the

@@ -255,3 +255,59 @@ TEST(CholmodReuse, SceneRunsTheSameTrajectoryWithFewerFactorisations) {
 }
 
 }  // namespace
+
+// 'reuse by cost': the CG budget rises to one factorisation's cost in CG
+// iterations, F / (4 (4 |L| + 2 |A|)). For a dense n x n matrix F ~ n^3 / 3,
+// |L| = n^2 (one supernode, stored as a full n x n block) and |A| = n^2, so
+// the budget is about n / 72: 8 at n = 600, above the fixed budget of 2
+// given here. A 5 % change of the
+// diagonal then needs more than 2 CG iterations on the old factor: with the
+// fixed budget the matrix is factorised anew, with the budget by cost CG
+// solves it on the old factor.
+namespace {
+RCP<Matrix> dense_spd(int n, const std::vector<double>& diag_scale) {
+  auto map = rcp(new Map(n, 0, fixtures::comm()));
+  auto A = rcp(new Matrix(map, n));
+  std::vector<GO> cols(n);
+  for (int j = 0; j < n; ++j) cols[j] = j;
+  for (int i = 0; i < n; ++i) {
+    std::vector<double> vals(n);
+    for (int j = 0; j < n; ++j) vals[j] = i == j ? n * diag_scale[i] : std::sin(0.37 * (i + 1) * (j + 1)) * 0.9;
+    A->insertGlobalValues(GO(i), Teuchos::ArrayView<const GO>(cols), Teuchos::ArrayView<const double>(vals));
+  }
+  A->fillComplete();
+  return A;
+}
+}  // namespace
+
+TEST(CholmodReuse, TheBudgetByCostExceedsTheFixedOneForDenseFactors) {
+  constexpr int n = 600;
+  std::vector<double> scale(n, 1.0);
+  auto perturbed = scale;
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> u(-0.05, 0.05);
+  for (double& s : perturbed) s *= 1.0 + u(rng);
+  for (bool by_cost : {false, true}) {
+    SCOPED_TRACE(by_cost ? "by cost" : "fixed");
+    auto A = dense_spd(n, scale);
+    Vector b(A->getRowMap()), x(A->getRowMap());
+    b.randomize();
+    CholmodReuse reuse{2, 1e-10};
+    reuse.by_cost = by_cost;
+    CholmodDirect solver(reuse);
+    solver.set_matrix(A);
+    EXPECT_TRUE(solver.solve(b, x).factorised);
+    copy_values(*dense_spd(n, perturbed), *A);
+    const auto r = solver.solve(b, x);
+    EXPECT_LT(relative_residual(*A, x, b), 1e-10);
+    if (by_cost) {
+      EXPECT_GE(r.cg_budget, 7);
+      EXPECT_LE(r.cg_budget, 9);
+      EXPECT_FALSE(r.factorised) << r.cg_iterations << " CG iterations";
+      EXPECT_GT(r.cg_iterations, 2);
+    } else {
+      EXPECT_EQ(r.cg_budget, 2);
+      EXPECT_TRUE(r.factorised);
+    }
+  }
+}

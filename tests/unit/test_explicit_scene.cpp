@@ -69,6 +69,7 @@ TEST(ExplicitScene, BadValuesAreRefusedNamingTheKey) {
   refused({"Materials/lower/K=0"}, "Materials/lower/K' = 0: expected K > 0");
   refused({"MPM Bodies/upper/material=lower"}, "Materials/upper' = \\(no MPM body\\): expected a material class with particles");
   refused({"Time/dt=1e-5"}, "Time/dt' = 1e-05: expected <= the CFL limit 1.29");
+  refused({"MPM/sort particles every=5"}, "MPM/sort particles every' = \\(given\\): expected no implicit-only key");
 }
 
 std::string with(const std::string& insert) {
