@@ -77,11 +77,18 @@ MpmBodies<dim>::MpmBodies(MpmSetup<dim> setup, Kokkos::View<MaterialParams*, Mem
   stencils_.materials = materials_;
   resize_stencils();
   n_total_ = static_cast<long long>(np);
-  ids_ = Kokkos::View<long long*, MemSpace>("mpm_particle_ids", np);
+  reset_ids();
+  term_ = std::make_unique<MpmElasticityTerm<dim>>("mpm elasticity", stencils_);
+}
+
+template <int dim>
+void MpmBodies<dim>::reset_ids() {  // one rank, particles in scene order: id q at row q
+  const std::size_t np = setup_.particles.size();
+  if (ids_.extent(0) != np) ids_ = Kokkos::View<long long*, MemSpace>("mpm_particle_ids", np);
   auto ids = ids_;
   Kokkos::parallel_for(
       "mpm_ids", Kokkos::RangePolicy<ExecSpace>(0, np), KOKKOS_LAMBDA(const std::size_t q) { ids(q) = q; });
-  term_ = std::make_unique<MpmElasticityTerm<dim>>("mpm elasticity", stencils_);
+  sorted_ = false;
 }
 
 template <int dim>
@@ -116,11 +123,7 @@ void MpmBodies<dim>::replace_particles(const Particles<dim>& all) {
   n_total_ = static_cast<long long>(all.size());
   if (!distributed_) {
     setup_.particles = all;
-    if (ids_.extent(0) != all.size()) ids_ = Kokkos::View<long long*, MemSpace>("mpm_particle_ids", all.size());
-    auto ids = ids_;
-    Kokkos::parallel_for(
-        "mpm_ids", Kokkos::RangePolicy<ExecSpace>(0, all.size()), KOKKOS_LAMBDA(const std::size_t q) { ids(q) = q; });
-    sorted_ = false;
+    reset_ids();
     resize_stencils();
     return;
   }
@@ -327,16 +330,9 @@ void MpmBodies<dim>::sum_shared_nodes() {
 
 template <int dim>
 void MpmBodies<dim>::sort_by_cell() {
-  // One rank: first back into id order, so that the order within a cell (by
-  // index, bin_particles) is by id and the sorted order depends on the
-  // positions alone: a restarted run sorts as the uninterrupted one did.
-  if (!distributed_ && sorted_) {
-    setup_.particles = particles_by_id(setup_.particles, ids_);
-    auto ids = ids_;
-    Kokkos::parallel_for(
-        "mpm_ids", Kokkos::RangePolicy<ExecSpace>(0, ids.extent(0)), KOKKOS_LAMBDA(const std::size_t q) { ids(q) = q; });
-  }
-  bin_particles(setup_.grid, setup_.particles, cells_);
+  // Within a cell by id: the sorted order depends on the positions and ids
+  // alone, so a restarted run sorts as the uninterrupted one did.
+  bin_particles(setup_.grid, setup_.particles, cells_, Kokkos::View<const long long*, MemSpace>(ids_));
   permute_particles(setup_.particles, ids_, Kokkos::View<const LO*, MemSpace>(cells_.order));
   sorted_ = true;
   ++sorts_;

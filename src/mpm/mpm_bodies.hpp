@@ -44,7 +44,7 @@ struct MpmSetup {
   // 'MPM/rebalance above').
   double rebalance_above = 1.2;
   // Particles reordered by cell (the base node of their B-spline stencil,
-  // x fastest; within a cell by id on one rank) at the start of steps 1,
+  // x fastest; within a cell by global id) at the start of steps 1,
   // 1 + sort_every, 1 + 2 sort_every, ..., so that neighbouring particles
   // touch neighbouring grid rows (0: never; scene key 'MPM/sort particles
   // every'). The run is the same to round-off (summation orders change). In
@@ -191,6 +191,7 @@ class MpmBodies {
   bool sorted_ = false;  // reordered by cell since construction or replace_particles
   int sorts_ = 0;
   void sort_by_cell();
+  void reset_ids();
   double migration_s_ = 0;
   int rebalances_ = 0;
   double imbalance_ = 1.0, retry_above_ = 0.0;  // retry_above_: a failed rebalance waits for more imbalance

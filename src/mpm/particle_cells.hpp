@@ -48,8 +48,13 @@ KOKKOS_INLINE_FUNCTION int cell_color(const GridSpec<dim>& grid, LO node) {
   return c;
 }
 
+// key (optional, one per particle, distinct): the order within a cell is by
+// increasing key instead of increasing index (the periodic sort passes the
+// particles' global ids, so that the sorted order depends on the positions
+// and ids alone, not on the order the particles had before).
 template <int dim>
-void bin_particles(const GridSpec<dim>& grid, const Particles<dim>& p, ParticleCells<dim>& pc) {
+void bin_particles(const GridSpec<dim>& grid, const Particles<dim>& p, ParticleCells<dim>& pc,
+                   Kokkos::View<const long long*, MemSpace> key = {}) {
   constexpr int nc = ParticleCells<dim>::n_colors;
   const LO n_nodes = grid.num_nodes();
   const LO np = static_cast<LO>(p.size());
@@ -116,11 +121,13 @@ void bin_particles(const GridSpec<dim>& grid, const Particles<dim>& p, ParticleC
       "mpm_cell_sort", Kokkos::RangePolicy<ExecSpace>(0, n_nodes), KOKKOS_LAMBDA(const LO n) {
         const LO k = count(n);
         if (k == 0) return;
-        // Increasing particle index within the cell (insertion sort; a few particles).
+        // Increasing particle index (or key) within the cell (insertion sort; a few particles).
+        const bool keyed = key.extent(0) > 0;
         for (LO i = start(n) + 1; i < start(n) + k; ++i) {
           const LO v = order(i);
+          const long long kv = keyed ? key(v) : v;
           LO j = i - 1;
-          while (j >= start(n) && order(j) > v) {
+          while (j >= start(n) && (keyed ? key(order(j)) : order(j)) > kv) {
             order(j + 1) = order(j);
             --j;
           }

@@ -219,13 +219,12 @@ LinearSolver::LinearSolver(const ParameterList& params, const RCP<const Comm>& c
     throw std::invalid_argument(msg.str());
   }
   impl_->reuse.max_iterations = kCholmodReuseIterations;
+  impl_->reuse.by_cost = true;  // the schema's default
   if (params.isSublist("Cholmod")) {  // a list without it (built by hand) takes the defaults
     const ParameterList& ch = params.sublist("Cholmod");
     if (ch.isParameter("reuse iterations")) impl_->reuse.max_iterations = ch.get<int>("reuse iterations");
     if (ch.isParameter("reuse tolerance")) impl_->reuse.tolerance = ch.get<double>("reuse tolerance");
-    impl_->reuse.by_cost = ch.isParameter("reuse by cost") ? ch.get<bool>("reuse by cost") : true;
-  } else {
-    impl_->reuse.by_cost = true;
+    if (ch.isParameter("reuse by cost")) impl_->reuse.by_cost = ch.get<bool>("reuse by cost");
   }
   // Cholmod keys away from their defaults would be ignored by another solver: refuse them.
   const CholmodDirect::Reuse defaults;
