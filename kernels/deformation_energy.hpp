@@ -128,7 +128,8 @@ KOKKOS_INLINE_FUNCTION void symmetric_from_lower(SquareMat<n>& H) {
 }
 
 // scale * (gradient, PSD-projected Hessian) of stencils into the sink, which
-// eliminates prescribed DOFs (kernels/dof_sink.hpp): stencils order(k), k in
+// eliminates prescribed DOFs (kernels/dof_sink.hpp; at the positions of its
+// scatter table when it holds one for these stencils): stencils order(k), k in
 // [k0, k1) (all stencils, in index order, when `order` is empty), in
 // parallel; the sink's `atomic` flag says whether they may share nodes.
 template <int dim, int nv, class Sink>
@@ -137,6 +138,7 @@ void deformation_assemble(const DeformationStencils<dim, nv>& s, Kokkos::View<co
                           LO k0 = 0, LO k1 = -1) {
   constexpr int nd = nv * dim;
   const bool ordered = order.extent(0) > 0;
+  const long n_stencils = s.size();  // the sink's scatter table, if it has one, is by stencil index q
   if (k1 < 0) k1 = ordered ? static_cast<LO>(order.extent(0)) : s.size();
   Kokkos::parallel_for(
       "deformation_assemble", Kokkos::RangePolicy<ExecSpace>(k0, k1), KOKKOS_LAMBDA(const LO k) {
@@ -147,7 +149,7 @@ void deformation_assemble(const DeformationStencils<dim, nv>& s, Kokkos::View<co
         symmetric_from_lower<nd>(Hl);
         LO nodes[nv];
         for (int a = 0; a < nv; ++a) nodes[a] = s.nodes(q, a);
-        sink.add_stencil(nodes, nv, gl, &Hl);
+        sink.add_stencil(nodes, nv, gl, &Hl, sink.stencil_positions(q, nv, n_stencils));
       });
 }
 

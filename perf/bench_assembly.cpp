@@ -7,6 +7,8 @@
 //   fem               FEM simplices (triangles / tetrahedra): gradient +
 //                     projected (d+1)d square Hessian into the matrix, per
 //                     element, colored without atomics (what the simulation runs);
+//   mpm_cells_search, fem_search  the same without the scatter table: every
+//                     3x3 (2x2) block found by bisection in its row;
 //   fem_atomic        the same, all elements at once with atomic adds;
 //                     (on 1 thread both rows run all elements in index order
 //                     without atomics: DeformationTerm::assemble)
@@ -73,12 +75,15 @@ struct Sys {
   explicit Sys(std::size_t nd) : grad("grad", nd), rhs("rhs", nd), dxp("dxp", nd), pres("pres", nd) {}
 };
 
+// tabled: the sink carries the scatter table of the space's only term (as
+// the Newton solver hands it over); otherwise every block is found by bisection.
 template <int dim>
-double time_assembly(DofSpace<dim>& space, const std::function<void(const Sink<dim>&)>& assemble) {
+double time_assembly(DofSpace<dim>& space, const std::function<void(const Sink<dim>&)>& assemble, bool tabled = true) {
   Sys s(space.num_dofs());
   return best_of(5, [&] {
     space.begin_assembly();
-    assemble(space.sink(1.0, s.grad, s.rhs, s.pres, s.dxp));
+    const Sink<dim> sink = space.sink(1.0, s.grad, s.rhs, s.pres, s.dxp);
+    assemble(tabled ? space.term_sink(sink, 0) : sink);
   });
 }
 
@@ -130,6 +135,8 @@ void mpm_rows(double target, std::vector<Json>& out, const Teuchos::RCP<const Co
   const auto& term = mpm.term();
   const double goal = dim == 2 ? 1500.0 : 15000.0;  // 2D: not in the table; 1/10 of 3D's
   out.push_back(row(dim, "mpm_cells", np, time_assembly<dim>(space, [&](const Sink<dim>& s) { term.assemble(x, s); }), goal));
+  out.push_back(row(dim, "mpm_cells_search", np,
+                    time_assembly<dim>(space, [&](const Sink<dim>& s) { term.assemble(x, s); }, false), goal));
   out.push_back(row(dim, "mpm_per_particle", np,
                     time_assembly<dim>(space, [&](const Sink<dim>& s) { term.assemble_per_particle(x, s); }), goal));
 }
@@ -161,6 +168,8 @@ void fem_rows(double h, std::vector<Json>& out, const Teuchos::RCP<const Comm>& 
                     time_assembly<dim>(space, [&](const Sink<dim>& s) { term.assemble(x, s); }), goal));
   term.set_coloring(color_stencils<dim + 1>(mesh.elements.nodes, mesh.num_nodes()));  // as the simulation runs it
   out.push_back(row(dim, "fem", mesh.num_cells(), time_assembly<dim>(space, [&](const Sink<dim>& s) { term.assemble(x, s); }), goal));
+  out.push_back(row(dim, "fem_search", mesh.num_cells(),
+                    time_assembly<dim>(space, [&](const Sink<dim>& s) { term.assemble(x, s); }, false), goal));
 }
 
 }  // namespace

@@ -324,6 +324,8 @@ RunSummary run_dim(const Scene& scene, const std::string& dir, const Teuchos::RC
   for (const auto& [name, sec] : sim.newton().term_assembly_seconds()) s.term_assembly_s.emplace_back(name, sec);
   s.graph_builds = sim.newton().dof_space().graph_builds();
   s.graph_build_causes = sim.newton().dof_space().build_causes();
+  s.scatter_tables = sim.newton().dof_space().scatter_table_builds();
+  s.scatter_table_s = sim.newton().dof_space().scatter_table_seconds();
   s.ranks = comm->getSize();
   s.exchange_s = sim.newton().dof_space().exchange_seconds();
   s.exchange_mb = 1e-6 * sim.newton().dof_space().exchange_bytes();
@@ -420,6 +422,9 @@ RunSummary run_scene(const Scene& scene, const std::string& dir, const Teuchos::
       log << (k ? ", " : "") << s.graph_build_causes[k].first << " " << s.graph_build_causes[k].second;
     log << (s.ranks > 1 ? " (on rank 0)" : "") << "\n";
   }
+  if (s.scatter_tables > 0)
+    log << "  scatter tables      " << s.scatter_tables << " built (" << s.scatter_table_s
+        << " s; block positions of the FEM and MPM stencils" << (s.ranks > 1 ? ", on rank 0" : "") << ")\n";
   log
       << "  linear-solve time   " << s.solve_s << " s\n";
   if (s.numeric_factorizations > 0)

@@ -32,6 +32,8 @@ struct RunSummary {
   double exchange_mb = 0;  // MB the busiest rank sent in the DOF exchanges
   double graph_build_s = 0;  // DofSpace graph builds (the slowest rank)
   long graph_builds = 0, symbolic_factorizations = 0, numeric_factorizations = 0;
+  long scatter_tables = 0;  // DofSpace scatter tables built (rank 0's), and their seconds
+  double scatter_table_s = 0;
   double factor_s = 0, reuse_cg_s = 0;  // Cholmod (within solve_s)
   long reuse_cg_iterations = 0;
   long stale_retries = 0;  // CG + BLOCK_CHOLMOD solves redone after the kept factor failed

@@ -44,6 +44,7 @@ void MpmElasticityTerm<dim>::assemble(ConstDofView x, const Sink<dim>& sink) con
     throw std::logic_error("MpmElasticityTerm::assemble: particles not binned into cells for these stencils");
   Sink<dim> plain = sink;
   plain.atomic = false;  // the cells of one color share no node
+  const long n_cells = cells_.n_cells;  // the sink's scatter table, if any, is by cell
   for (int c = 0; c < nc; ++c) {
     const LO c0 = cells_.color_start(c), c1 = cells_.color_start(c + 1);
     if (c1 == c0) continue;
@@ -57,9 +58,23 @@ void MpmElasticityTerm<dim>::assemble(ConstDofView x, const Sink<dim>& sink) con
           symmetric_from_lower<nd>(Hl);
           LO nodes[ns];
           for (int a = 0; a < ns; ++a) nodes[a] = s.nodes(order(first), a);
-          plain.add_stencil(nodes, ns, gl, &Hl);
+          plain.add_stencil(nodes, ns, gl, &Hl, plain.stencil_positions(k, ns, n_cells));
         });
   }
+}
+
+template <int dim>
+long MpmElasticityTerm<dim>::scatter_table(const LocalMatrix& A, Kokkos::View<int*, MemSpace>& table) const {
+  constexpr int ns = bspline_stencil_size<dim>;
+  const auto nodes = this->stencils().nodes;
+  const auto cells = cells_.cells;
+  const auto start = cells_.start;
+  const auto order = cells_.order;
+  const long n_cells = cells_.n_cells;
+  scatter_positions<dim>(
+      A.graph, n_cells, ns, KOKKOS_LAMBDA(const long k, const int a) { return nodes(order(start(cells(k))), a); },
+      table);
+  return n_cells;
 }
 
 template <int dim>

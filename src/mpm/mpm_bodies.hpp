@@ -69,13 +69,24 @@ class MpmElasticityTerm : public DeformationTerm<dim, bspline_stencil_size<dim>>
   // The stencil-by-stencil assembly with atomics (the generic path; tests
   // compare the two).
   void assemble_per_particle(ConstDofView x, const Sink<dim>& sink) const {
-    DeformationTerm<dim, bspline_stencil_size<dim>>::assemble(x, sink);
+    Sink<dim> searching = sink;  // the table is by cell
+    searching.table_stencils = 0;
+    DeformationTerm<dim, bspline_stencil_size<dim>>::assemble(x, searching);
   }
-  void set_cells(const ParticleCells<dim>& c) { cells_ = c; }
+  // By cell: stencil k is cells().cells(k), the nodes of its first particle.
+  long scatter_table(const LocalMatrix& A, Kokkos::View<int*, MemSpace>& table) const override;
+  std::uint64_t stencils_version() const override {
+    return cells_version_ + DeformationTerm<dim, bspline_stencil_size<dim>>::stencils_version();
+  }
+  void set_cells(const ParticleCells<dim>& c) {
+    cells_ = c;
+    ++cells_version_;
+  }
   const ParticleCells<dim>& cells() const { return cells_; }
 
  private:
   ParticleCells<dim> cells_;
+  std::uint64_t cells_version_ = 0;  // set_cells calls (the cell list is rebuilt every step)
 };
 
 template <int dim>

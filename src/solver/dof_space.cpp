@@ -106,6 +106,7 @@ bool DofSpace<dim>::set_structure(LO n_nodes, const std::vector<const EnergyTerm
   versions_ = std::move(versions);
   if (same) {
     ++graph_reuses_;
+    refresh_tables(false);
     return false;
   }
   if (distributed()) {
@@ -174,6 +175,49 @@ void DofSpace<dim>::rebuild(const std::string& cause) {
   ++graph_builds_;
   graph_build_s_ = timer.seconds();
   graph_build_total_s_ += graph_build_s_;
+  refresh_tables(true);
+}
+
+template <int dim>
+void DofSpace<dim>::refresh_tables(bool graph_rebuilt) {
+  if (tables_.size() != terms_.size()) {
+    tables_.resize(terms_.size());
+    graph_rebuilt = true;
+  }
+  const auto lcl = (distributed() ? *A_overlap_ : *A_).getLocalMatrixDevice();
+  for (std::size_t k = 0; k < terms_.size(); ++k) {
+    Table& t = tables_[k];
+    const std::uint64_t v = terms_[k]->stencils_version();
+    if (!use_tables_) {
+      t = Table{};
+      continue;
+    }
+    if (!graph_rebuilt && t.built && v == t.version) continue;
+    Kokkos::Timer timer;
+    t.stencils = terms_[k]->scatter_table(lcl, t.positions);
+    t.version = v;
+    t.built = true;
+    Kokkos::fence();
+    if (t.stencils > 0) {
+      ++table_builds_;
+      table_s_ += timer.seconds();
+    }
+  }
+}
+
+template <int dim>
+Sink<dim> DofSpace<dim>::term_sink(const Sink<dim>& sink, std::size_t k) const {
+  Sink<dim> s = sink;
+  if (k >= tables_.size() || tables_[k].stencils == 0) {
+    s.table_stencils = 0;
+    return s;
+  }
+  if (terms_[k]->stencils_version() != tables_[k].version)
+    throw std::logic_error("DofSpace::term_sink: the stencils of term '" + terms_[k]->name() +
+                           "' changed after the scatter table was built (call set_structure first)");
+  s.table = tables_[k].positions;
+  s.table_stencils = tables_[k].stencils;
+  return s;
 }
 
 template <int dim>

@@ -12,7 +12,10 @@
 //     columns move to the right-hand side in the sink, kernels/dof_sink.hpp)
 //     and slip constraints on grid nodes (SlipConstraints), applied here only;
 //   - the sink through which every term adds its local (nodes, gradient,
-//     Hessian).
+//     Hessian), and each term's scatter table (kernels/dof_sink.hpp: its
+//     stencils' block positions in the graph), refreshed after a graph build
+//     and when the term's stencils_version() changes; term_sink() hands a
+//     term the sink with its table.
 // One rank (no partition): local ids == DOF ids.
 // Distributed (set_partition): the local nodes are this rank's owned nodes
 // (first) and its ghosts, each with a global node id. Every local View (x,
@@ -85,6 +88,14 @@ class DofSpace {
   // Assembly: zero the matrix values, hand out the sink, close.
   void begin_assembly();
   Sink<dim> sink(double scale, DofView grad, DofView rhs, MaskView prescribed, ConstDofView dx_prescribed) const;
+  // `sink` with the scatter table of terms()[k] (throws when the term's
+  // stencils changed after the last set_structure / rebuild).
+  Sink<dim> term_sink(const Sink<dim>& sink, std::size_t k) const;
+  // false: no scatter tables (every block found by bisection; tests compare
+  // the two). Takes effect at the next set_structure.
+  void use_scatter_tables(bool on) { use_tables_ = on; }
+  long scatter_table_builds() const { return table_builds_; }
+  double scatter_table_seconds() const { return table_s_; }
   // Constraint rows: A(i, i) = 1 and rhs(i) = dxp(i) at prescribed DOFs (the
   // caller has added the free rows' own diagonal), then the slip transform
   // A <- P A P + Q, rhs <- P (rhs - A w) + w on slip nodes; fillComplete.
@@ -148,6 +159,19 @@ class DofSpace {
   void build_maps();
   std::vector<const EnergyTerm<dim>*> terms_;
   std::vector<std::uint64_t> versions_;
+  // Scatter tables, per term: positions, stencil count, stencils_version().
+  struct Table {
+    Kokkos::View<int*, MemSpace> positions;
+    long stencils = 0;
+    std::uint64_t version = 0;
+    bool built = false;
+  };
+  std::vector<Table> tables_;
+  bool use_tables_ = true;
+  long table_builds_ = 0;
+  double table_s_ = 0;
+  // Refreshes the tables of terms whose stencils changed (all after a graph build).
+  void refresh_tables(bool graph_rebuilt);
   SlipConstraints<dim> slip_;
   long graph_builds_ = 0, graph_reuses_ = 0, missing_rebuilds_ = 0;
   std::vector<std::pair<std::string, long>> causes_;

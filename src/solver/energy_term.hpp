@@ -58,6 +58,15 @@ class EnergyTerm {
   virtual void assemble(ConstDofView x, const Sink<dim>& sink) const = 0;
   // Largest step along p keeping the term defined (inf if unbounded).
   virtual double max_step(ConstDofView x, ConstDofView p) const = 0;
+  // Scatter table (kernels/dof_sink.hpp): the block positions of this term's
+  // stencils in A's graph, written into `table` (reallocated only when too
+  // small); returns the number of stencils, or 0 when the term finds its
+  // blocks itself (contact pairs, which change within a step). The DOF space
+  // calls it after each graph build and whenever stencils_version() changes,
+  // and hands the table to assemble() in the sink (DofSpace::term_sink).
+  virtual long scatter_table(const LocalMatrix& /*A*/, Kokkos::View<int*, MemSpace>& /*table*/) const { return 0; }
+  // Changes whenever the nodes of the term's stencils may have changed.
+  virtual std::uint64_t stencils_version() const { return 0; }
   // Called at every Newton iterate x before its assembly (contact: the pairs
   // near x; terms keep such caches as mutable state). Returns true when the term now needs couplings the current graph
   // lacks; the solver then rebuilds the graph (add_couplings is asked again).
@@ -74,7 +83,17 @@ class DeformationTerm : public EnergyTerm<dim> {
  public:
   DeformationTerm(std::string name, DeformationStencils<dim, nv> s) : name_(std::move(name)), s_(s) {}
   std::string name() const override { return name_; }
-  void set_stencils(DeformationStencils<dim, nv> s) { s_ = s; }
+  void set_stencils(DeformationStencils<dim, nv> s) {
+    s_ = s;
+    ++stencils_version_;
+  }
+  std::uint64_t stencils_version() const override { return stencils_version_; }
+  long scatter_table(const LocalMatrix& A, Kokkos::View<int*, MemSpace>& table) const override {
+    const auto nodes = s_.nodes;
+    scatter_positions<dim>(A.graph, s_.size(), nv, KOKKOS_LAMBDA(const long q, const int a) { return nodes(q, a); },
+                           table);
+    return s_.size();
+  }
   const DeformationStencils<dim, nv>& stencils() const { return s_; }
 
   void add_couplings(std::vector<long long>& keys, LO n_nodes) const override {
@@ -120,6 +139,7 @@ class DeformationTerm : public EnergyTerm<dim> {
   DeformationStencils<dim, nv> s_;
   bool project_ = true;
   StencilColoring coloring_;
+  std::uint64_t stencils_version_ = 0;
 };
 
 }  // namespace bfemp

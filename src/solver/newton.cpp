@@ -133,9 +133,10 @@ struct NewtonSolver<dim>::Impl {
     Sink<dim> sink = dofs.sink(ip.h, g, r, ip.prescribed, dxp);
     sink.project = project;
     sink.contact_keep = project ? contact_keep : 0.0;
-    for (const auto* t : dofs.terms()) {
+    for (std::size_t k = 0; k < dofs.terms().size(); ++k) {
+      const auto* t = dofs.terms()[k];
       Kokkos::Timer timer;
-      t->assemble(x, sink);
+      t->assemble(x, dofs.term_sink(sink, k));
       Kokkos::fence();
       term_s[t->name()] += timer.seconds();
     }

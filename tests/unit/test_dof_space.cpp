@@ -4,7 +4,9 @@
 //    the same local gradients and Hessians with the elimination written out
 //    (the rule the terms used to apply each on their own), entry by entry,
 //    for FEM triangles / tetrahedra and MPM particles (per particle with
-//    atomics, and by cell and color without), with some DOFs prescribed;
+//    atomics, and by cell and color without), with some DOFs prescribed, with
+//    each block found by bisection and through the scatter table; a table
+//    whose stencils changed is refused until set_structure rebuilds it;
 //  - the graph is cached: a scene whose structure does not change builds it
 //    once, and a direct solver runs its symbolic phase once;
 //  - particle order does not change a run beyond round-off.
@@ -14,6 +16,7 @@
 #include <Tpetra_Vector.hpp>
 #include <algorithm>
 #include <random>
+#include <stdexcept>
 
 #include "common/mpm_fixtures.hpp"
 #include "fem/fem_mesh.hpp"
@@ -61,9 +64,12 @@ Dense dense_reference(const DeformationStencils<dim, nv>& s, Kokkos::View<const 
   return d;
 }
 
+// tabled: the sink carries the scatter table of the space's term 0 (as the
+// Newton solver hands it over); otherwise every block is found by bisection.
 template <int dim>
 Dense assemble_with(const DofSpace<dim>& space, std::size_t nd, double scale, const std::vector<int>& pres,
-                    const std::vector<double>& dxp, const std::function<void(const Sink<dim>&)>& assemble) {
+                    const std::vector<double>& dxp, const std::function<void(const Sink<dim>&)>& assemble,
+                    bool tabled = false) {
   Kokkos::View<double*, MemSpace> grad("grad", nd), rhs("rhs", nd), dx("dxp", nd);
   Kokkos::View<int*, MemSpace> p("pres", nd);
   for (std::size_t i = 0; i < nd; ++i) {
@@ -73,7 +79,14 @@ Dense assemble_with(const DofSpace<dim>& space, std::size_t nd, double scale, co
   auto A = space.matrix();
   A->resumeFill();
   A->setAllToScalar(0.0);
-  assemble(space.sink(scale, grad, rhs, p, dx));
+  const Sink<dim> sink = space.sink(scale, grad, rhs, p, dx);
+  if (tabled) {
+    const Sink<dim> ts = space.term_sink(sink, 0);
+    EXPECT_GT(ts.table_stencils, 0) << "no scatter table";
+    assemble(ts);
+  } else {
+    assemble(sink);
+  }
   Kokkos::fence();
   A->fillComplete();
   Dense d;
@@ -153,6 +166,36 @@ void fem_case() {
   const Dense colored =
       assemble_with<dim>(space, nd, scale, pres, dxp, [&](const Sink<dim>& s) { term.assemble(x, s); });
   expect_same(colored, ref, nd, "FEM colored");
+  // Through the scatter table (built by set_structure): the same matrix.
+  EXPECT_EQ(space.scatter_table_builds(), 1);
+  const Dense tabled =
+      assemble_with<dim>(space, nd, scale, pres, dxp, [&](const Sink<dim>& s) { term.assemble(x, s); }, true);
+  expect_same(tabled, ref, nd, "FEM colored, scatter table");
+  // New stencils (here: the same elements in reverse order) without a new
+  // set_structure: the stale table is refused; after it, rebuilt and right.
+  DeformationStencils<dim, dim + 1> rev = mesh.elements;
+  rev.nodes = decltype(rev.nodes)("rev_nodes", mesh.num_cells());
+  rev.g = decltype(rev.g)("rev_g", mesh.num_cells());
+  rev.volume = decltype(rev.volume)("rev_volume", mesh.num_cells());
+  rev.material = decltype(rev.material)("rev_material", mesh.num_cells());
+  const LO ne = mesh.num_cells();
+  for (LO q = 0; q < ne; ++q) {
+    for (int a = 0; a <= dim; ++a) {
+      rev.nodes(q, a) = mesh.elements.nodes(ne - 1 - q, a);
+      for (int j = 0; j < dim; ++j) rev.g(q, a, j) = mesh.elements.g(ne - 1 - q, a, j);
+    }
+    rev.volume(q) = mesh.elements.volume(ne - 1 - q);
+    rev.material(q) = mesh.elements.material(ne - 1 - q);
+  }
+  term.set_stencils(rev);
+  term.set_coloring(color_stencils<dim + 1>(rev.nodes, n));
+  EXPECT_THROW(assemble_with<dim>(space, nd, scale, pres, dxp, [&](const Sink<dim>& s) { term.assemble(x, s); }, true),
+               std::logic_error);
+  EXPECT_FALSE(space.set_structure(n, {&term}));  // same couplings: the graph serves, the table is rebuilt
+  EXPECT_EQ(space.scatter_table_builds(), 2);
+  const Dense reversed =
+      assemble_with<dim>(space, nd, scale, pres, dxp, [&](const Sink<dim>& s) { term.assemble(x, s); }, true);
+  expect_same(reversed, ref, nd, "FEM reversed, scatter table");
   std::cout << "  FEM " << dim << "D: " << mesh.num_cells() << " elements in " << col.colors() << " colors, " << nd
             << " DOFs\n";
 }
@@ -210,6 +253,27 @@ void mpm_case(int n_particles) {
       assemble_with<dim>(space, nd, scale, pres, dxp, [&](const Sink<dim>& sk) { term.assemble_per_particle(x, sk); });
   expect_same(cellwise, ref, nd, "MPM by cell and color");
   expect_same(per_particle, ref, nd, "MPM per particle");
+  // Through the scatter table (by cell): the same matrix; the per-particle
+  // path ignores the cell table.
+  EXPECT_EQ(space.scatter_table_builds(), 1);
+  const Dense cell_table =
+      assemble_with<dim>(space, nd, scale, pres, dxp, [&](const Sink<dim>& sk) { term.assemble(x, sk); }, true);
+  expect_same(cell_table, ref, nd, "MPM by cell, scatter table");
+  const Dense per_particle_tabled = assemble_with<dim>(
+      space, nd, scale, pres, dxp, [&](const Sink<dim>& sk) { term.assemble_per_particle(x, sk); }, true);
+  expect_same(per_particle_tabled, ref, nd, "MPM per particle, sink with a cell table");
+  // Every table entry of a cell whose rows are free is a real block position.
+  {
+    DofSpace<dim> probe(comm());
+    ASSERT_TRUE(probe.set_structure(n, {&term}));
+    Kokkos::View<double*, MemSpace> g0("g0", nd), r0("r0", nd), d0("d0", nd);
+    Kokkos::View<int*, MemSpace> p0("p0", nd);
+    const Sink<dim> ts = probe.term_sink(probe.sink(1.0, g0, r0, p0, d0), 0);
+    ASSERT_EQ(ts.table_stencils, cells.n_cells);
+    int missing = 0;
+    for (std::size_t i = 0; i < static_cast<std::size_t>(cells.n_cells) * ns * ns; ++i) missing += ts.table(i) < 0;
+    EXPECT_EQ(missing, 0);
+  }
   std::cout << "  MPM " << dim << "D: " << n_particles << " particles in " << cells.n_cells << " cells, " << nd
             << " DOFs\n";
 }
