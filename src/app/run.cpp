@@ -424,7 +424,7 @@ RunSummary run_scene(const Scene& scene, const std::string& dir, const Teuchos::
   }
   if (s.scatter_tables > 0)
     log << "  scatter tables      " << s.scatter_tables << " built (" << s.scatter_table_s
-        << " s; block positions of the FEM and MPM stencils" << (s.ranks > 1 ? ", on rank 0" : "") << ")\n";
+        << " s; block positions of the elements' and MPM cells' stencils" << (s.ranks > 1 ? ", on rank 0" : "") << ")\n";
   log
       << "  linear-solve time   " << s.solve_s << " s\n";
   if (s.numeric_factorizations > 0)

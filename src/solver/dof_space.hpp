@@ -88,11 +88,12 @@ class DofSpace {
   // Assembly: zero the matrix values, hand out the sink, close.
   void begin_assembly();
   Sink<dim> sink(double scale, DofView grad, DofView rhs, MaskView prescribed, ConstDofView dx_prescribed) const;
-  // `sink` with the scatter table of terms()[k] (throws when the term's
-  // stencils changed after the last set_structure / rebuild).
+  // `sink` with the scatter table of terms()[k] (none for a term without
+  // one, e.g. contact); throws when a tabled term's stencils changed after
+  // the last set_structure / rebuild.
   Sink<dim> term_sink(const Sink<dim>& sink, std::size_t k) const;
   // false: no scatter tables (every block found by bisection; tests compare
-  // the two). Takes effect at the next set_structure.
+  // the two). Takes effect at the next set_structure or rebuild.
   void use_scatter_tables(bool on) { use_tables_ = on; }
   long scatter_table_builds() const { return table_builds_; }
   double scatter_table_seconds() const { return table_s_; }

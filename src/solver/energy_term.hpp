@@ -65,7 +65,10 @@ class EnergyTerm {
   // calls it after each graph build and whenever stencils_version() changes,
   // and hands the table to assemble() in the sink (DofSpace::term_sink).
   virtual long scatter_table(const LocalMatrix& /*A*/, Kokkos::View<int*, MemSpace>& /*table*/) const { return 0; }
-  // Changes whenever the nodes of the term's stencils may have changed.
+  // Changes whenever the nodes of the term's stencils may have changed. A
+  // term whose stencil Views are rewritten in place by their owner (the MPM
+  // bodies refill theirs every step) must be told (DeformationTerm::
+  // set_stencils, MpmElasticityTerm::set_cells) before the next set_structure.
   virtual std::uint64_t stencils_version() const { return 0; }
   // Called at every Newton iterate x before its assembly (contact: the pairs
   // near x; terms keep such caches as mutable state). Returns true when the term now needs couplings the current graph

@@ -171,6 +171,20 @@ void fem_case() {
   const Dense tabled =
       assemble_with<dim>(space, nd, scale, pres, dxp, [&](const Sink<dim>& s) { term.assemble(x, s); }, true);
   expect_same(tabled, ref, nd, "FEM colored, scatter table");
+  // A table that does not fit the graph (every position 0: in the row, the
+  // wrong block for most) is caught by the sink's check: the same matrix.
+  {
+    const LO ne = mesh.num_cells();
+    Kokkos::View<int*, MemSpace> junk("junk_table", static_cast<std::size_t>(ne) * (dim + 1) * (dim + 1));
+    Kokkos::deep_copy(junk, 0);
+    const Dense checked = assemble_with<dim>(space, nd, scale, pres, dxp, [&](const Sink<dim>& sk) {
+      Sink<dim> bad = sk;
+      bad.table = junk;
+      bad.table_stencils = ne;
+      term.assemble(x, bad);
+    });
+    expect_same(checked, ref, nd, "FEM, a table of wrong positions");
+  }
   // New stencils (here: the same elements in reverse order) without a new
   // set_structure: the stale table is refused; after it, rebuilt and right.
   DeformationStencils<dim, dim + 1> rev = mesh.elements;
@@ -259,10 +273,22 @@ void mpm_case(int n_particles) {
   const Dense cell_table =
       assemble_with<dim>(space, nd, scale, pres, dxp, [&](const Sink<dim>& sk) { term.assemble(x, sk); }, true);
   expect_same(cell_table, ref, nd, "MPM by cell, scatter table");
-  const Dense per_particle_tabled = assemble_with<dim>(
-      space, nd, scale, pres, dxp, [&](const Sink<dim>& sk) { term.assemble_per_particle(x, sk); }, true);
-  expect_same(per_particle_tabled, ref, nd, "MPM per particle, sink with a cell table");
-  // Every table entry of a cell whose rows are free is a real block position.
+  // The per-particle path with a table for as many stencils as particles (as
+  // a cell table would be with one particle per cell), of wrong positions:
+  // ignored, and the sink's check would catch it anyway.
+  {
+    Kokkos::View<int*, MemSpace> junk("junk_table", static_cast<std::size_t>(n_particles) * ns * ns);
+    Kokkos::deep_copy(junk, 0);  // block 0 of every row: valid in range, wrong column
+    const Dense per_particle_junk = assemble_with<dim>(space, nd, scale, pres, dxp, [&](const Sink<dim>& sk) {
+      Sink<dim> bad = sk;
+      bad.table = junk;
+      bad.table_stencils = n_particles;
+      term.assemble_per_particle(x, bad);
+    });
+    expect_same(per_particle_junk, ref, nd, "MPM per particle, sink with a table for as many stencils");
+  }
+  // Every table entry is a real block position (the graph holds every block
+  // of every cell).
   {
     DofSpace<dim> probe(comm());
     ASSERT_TRUE(probe.set_structure(n, {&term}));
@@ -273,6 +299,41 @@ void mpm_case(int n_particles) {
     int missing = 0;
     for (std::size_t i = 0; i < static_cast<std::size_t>(cells.n_cells) * ns * ns; ++i) missing += ts.table(i) < 0;
     EXPECT_EQ(missing, 0);
+  }
+  // Two tabled terms in one space (an FEM simplex on the first nodes, at
+  // rest, beside the MPM cells): each term gets its own table, and the sum
+  // is the same as with every block searched.
+  {
+    DeformationStencils<dim, dim + 1> fs;
+    fs.nodes = decltype(fs.nodes)("fem_nodes", 1);
+    fs.g = decltype(fs.g)("fem_g", 1);
+    fs.volume = decltype(fs.volume)("fem_volume", 1);
+    fs.material = decltype(fs.material)("fem_material", 1);
+    fs.materials = mats;
+    for (int a = 0; a <= dim; ++a) {
+      fs.nodes(0, a) = a;
+      for (int j = 0; j < dim; ++j) fs.g(0, a, j) = a == 0 ? -1.0 : (j == a - 1 ? 1.0 : 0.0);
+    }
+    fs.volume(0) = 1e-3;
+    fs.material(0) = 0;
+    for (int a = 1; a <= dim; ++a) x((a)*dim + (a - 1)) = 1.0 + 0.01 * a;  // node a at (1 + 0.01 a) e_a
+    DeformationTerm<dim, dim + 1> fem("fem", fs);
+    DofSpace<dim> both(comm());
+    ASSERT_TRUE(both.set_structure(n, {&fem, &term}));
+    Kokkos::View<double*, MemSpace> g0("g0", nd), r0("r0", nd), d0("d0", nd);
+    Kokkos::View<int*, MemSpace> p0("p0", nd);
+    const Sink<dim> plain = both.sink(1.0, g0, r0, p0, d0);
+    EXPECT_EQ(both.term_sink(plain, 0).table_stencils, 1);
+    EXPECT_EQ(both.term_sink(plain, 1).table_stencils, cells.n_cells);
+    const Dense searched = assemble_with<dim>(both, nd, scale, pres, dxp, [&](const Sink<dim>& sk) {
+      fem.assemble(x, sk);
+      term.assemble(x, sk);
+    });
+    const Dense tabled2 = assemble_with<dim>(both, nd, scale, pres, dxp, [&](const Sink<dim>& sk) {
+      fem.assemble(x, both.term_sink(sk, 0));
+      term.assemble(x, both.term_sink(sk, 1));
+    });
+    expect_same(tabled2, searched, nd, "FEM + MPM, a table per term");
   }
   std::cout << "  MPM " << dim << "D: " << n_particles << " particles in " << cells.n_cells << " cells, " << nd
             << " DOFs\n";
