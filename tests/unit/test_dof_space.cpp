@@ -122,6 +122,16 @@ void expect_same(const Dense& a, const Dense& b, std::size_t nd, const std::stri
   EXPECT_EQ(bad, 0) << what << ": entries differ";
 }
 
+// `sink` with a scatter table of wrong positions for `stencils` stencils of k
+// nodes: every entry 0 (inside each row, the wrong block for most).
+template <int dim>
+Sink<dim> with_wrong_table(const Sink<dim>& sink, long stencils, int k) {
+  Sink<dim> bad = sink;
+  bad.table = Kokkos::View<int*, MemSpace>("wrong_table", static_cast<std::size_t>(stencils) * k * k);  // zeros
+  bad.table_stencils = stencils;
+  return bad;
+}
+
 // Every third DOF prescribed with a random offset; returns the mask.
 std::vector<int> some_prescribed(std::size_t nd, std::vector<double>& dxp, unsigned seed) {
   std::mt19937 rng(seed);
@@ -173,18 +183,10 @@ void fem_case() {
   expect_same(tabled, ref, nd, "FEM colored, scatter table");
   // A table that does not fit the graph (every position 0: in the row, the
   // wrong block for most) is caught by the sink's check: the same matrix.
-  {
-    const LO ne = mesh.num_cells();
-    Kokkos::View<int*, MemSpace> junk("junk_table", static_cast<std::size_t>(ne) * (dim + 1) * (dim + 1));
-    Kokkos::deep_copy(junk, 0);
-    const Dense checked = assemble_with<dim>(space, nd, scale, pres, dxp, [&](const Sink<dim>& sk) {
-      Sink<dim> bad = sk;
-      bad.table = junk;
-      bad.table_stencils = ne;
-      term.assemble(x, bad);
-    });
-    expect_same(checked, ref, nd, "FEM, a table of wrong positions");
-  }
+  const Dense checked = assemble_with<dim>(space, nd, scale, pres, dxp, [&](const Sink<dim>& sk) {
+    term.assemble(x, with_wrong_table(sk, mesh.num_cells(), dim + 1));
+  });
+  expect_same(checked, ref, nd, "FEM, a table of wrong positions");
   // New stencils (here: the same elements in reverse order) without a new
   // set_structure: the stale table is refused; after it, rebuilt and right.
   DeformationStencils<dim, dim + 1> rev = mesh.elements;
@@ -276,17 +278,10 @@ void mpm_case(int n_particles) {
   // The per-particle path with a table for as many stencils as particles (as
   // a cell table would be with one particle per cell), of wrong positions:
   // ignored, and the sink's check would catch it anyway.
-  {
-    Kokkos::View<int*, MemSpace> junk("junk_table", static_cast<std::size_t>(n_particles) * ns * ns);
-    Kokkos::deep_copy(junk, 0);  // block 0 of every row: valid in range, wrong column
-    const Dense per_particle_junk = assemble_with<dim>(space, nd, scale, pres, dxp, [&](const Sink<dim>& sk) {
-      Sink<dim> bad = sk;
-      bad.table = junk;
-      bad.table_stencils = n_particles;
-      term.assemble_per_particle(x, bad);
-    });
-    expect_same(per_particle_junk, ref, nd, "MPM per particle, sink with a table for as many stencils");
-  }
+  const Dense per_particle_junk = assemble_with<dim>(space, nd, scale, pres, dxp, [&](const Sink<dim>& sk) {
+    term.assemble_per_particle(x, with_wrong_table(sk, n_particles, ns));
+  });
+  expect_same(per_particle_junk, ref, nd, "MPM per particle, sink with a table for as many stencils");
   // Every table entry is a real block position (the graph holds every block
   // of every cell).
   {
