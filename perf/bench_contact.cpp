@@ -102,11 +102,8 @@ std::string bench(long n_particles, long n_facets) {
       });
   const LO friction_pairs = contact.update_friction(x, xref, 1.0, 1e-3);
   const auto* friction = contact.friction();
-  std::vector<long long> keys;
-  barrier->add_couplings(keys, nn);
-  friction->add_couplings(keys, nn);
   auto map = Teuchos::rcp(new Map(static_cast<Tpetra::global_size_t>(nn * 2), 0, Tpetra::getDefaultComm()));
-  auto A = Teuchos::rcp(new Matrix(build_dof_graph<2>(keys, nn, map)));
+  auto A = Teuchos::rcp(new Matrix(build_dof_graph<2>({barrier, friction}, nn, map)));
   A->fillComplete();
   Kokkos::View<double*, MemSpace> grad("g", nn * 2), rhs("r", nn * 2), dxp("dxp", nn * 2);
   Kokkos::View<int*, MemSpace> pres("pres", nn * 2);

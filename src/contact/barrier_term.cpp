@@ -1,5 +1,6 @@
 #include "contact/barrier_term.hpp"
 
+#include <Kokkos_Sort.hpp>
 #include <Kokkos_Timer.hpp>
 #include <algorithm>
 #include <climits>
@@ -108,14 +109,12 @@ void BarrierTerm<dim>::begin_step(const ParticleStencils<dim>& ps, ConstDofView 
       });
   n_signature_ = n_pairs_;
   ++version_;
-  // The graph changes: the keys for add_couplings (host) and update() (device).
+  // The graph changes: its pairs' keys, for add_couplings and update().
   graph_keys_dev_ = Kokkos::View<long long*, MemSpace>("contact_graph_keys", static_cast<std::size_t>(n_pairs_));
   const auto keys = graph_keys_dev_;
   Kokkos::parallel_for(
       "contact_graph_keys", Kokkos::RangePolicy<ExecSpace>(0, n_pairs_),
       KOKKOS_LAMBDA(const LO k) { keys(k) = sig_dev(k, 0); });
-  auto hk = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), keys);
-  graph_keys_.assign(hk.data(), hk.data() + hk.extent(0));
 }
 
 template <int dim>
@@ -165,12 +164,25 @@ bool BarrierTerm<dim>::update(ConstDofView x) const {
       },
       missing);
   if (missing == 0) return false;
-  auto hp = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), pairs_);
-  for (LO k = 0; k < n_pairs_; ++k) graph_keys_.push_back(hp(k, 0) * np + hp(k, 1));
-  std::sort(graph_keys_.begin(), graph_keys_.end());
-  graph_keys_.erase(std::unique(graph_keys_.begin(), graph_keys_.end()), graph_keys_.end());
-  graph_keys_dev_ = Kokkos::View<long long*, MemSpace>("contact_graph_keys", graph_keys_.size());
-  Kokkos::deep_copy(graph_keys_dev_, Kokkos::View<const long long*, Kokkos::HostSpace>(graph_keys_.data(), graph_keys_.size()));
+  // The graph's keys and these pairs', sorted, without repeats (on the device).
+  const long long n_all = nk + n_pairs_;
+  Kokkos::View<long long*, MemSpace> all(Kokkos::ViewAllocateWithoutInitializing("contact_graph_keys_all"), n_all);
+  Kokkos::parallel_for(
+      "contact_graph_keys_all", Kokkos::RangePolicy<ExecSpace>(0, n_all), KOKKOS_LAMBDA(const long long i) {
+        all(i) = i < nk ? keys(i) : pairs(i - nk, 0) * np + pairs(i - nk, 1);
+      });
+  Kokkos::sort(all);
+  Kokkos::View<long long*, MemSpace> merged(Kokkos::ViewAllocateWithoutInitializing("contact_graph_keys"), n_all);
+  long long n_merged = 0;
+  Kokkos::parallel_scan(
+      "contact_graph_keys_unique", Kokkos::RangePolicy<ExecSpace>(0, n_all),
+      KOKKOS_LAMBDA(const long long i, long long& at, const bool final) {
+        if (i > 0 && all(i) == all(i - 1)) return;
+        if (final) merged(at) = all(i);
+        ++at;
+      },
+      n_merged);
+  graph_keys_dev_ = Kokkos::subview(merged, std::make_pair(0LL, n_merged));
   ++version_;
   grown_ = true;
   return true;
@@ -182,17 +194,12 @@ void BarrierTerm<dim>::prepare_direction(ConstDofView x, ConstDofView p) const {
 }
 
 template <int dim>
-void BarrierTerm<dim>::add_couplings(std::vector<long long>& keys, LO n_nodes) const {
-  auto pn = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), ps_.nodes);
-  auto vn = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), prims_.nodes);
-  auto vc = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), prims_.count);
+void BarrierTerm<dim>::add_couplings(NodeGraphBuilder& graph) const {
+  const auto keys = graph_keys_dev_;  // sorted: by particle
   const long long np = prims_.size();
-  LO last_q = -1;  // keys are sorted by particle
-  for (long long key : graph_keys_) {
-    const LO q = static_cast<LO>(key / np);
-    add_pair_couplings(pn, vn, vc, q, static_cast<LO>(key % np), n_nodes, q != last_q, keys);
-    last_q = q;
-  }
+  add_pair_couplings(
+      graph, static_cast<long>(keys.extent(0)), KOKKOS_LAMBDA(const long k) { return static_cast<LO>(keys(k) / np); },
+      KOKKOS_LAMBDA(const long k) { return static_cast<LO>(keys(k) % np); }, ps_.nodes, prims_.nodes, prims_.count);
 }
 
 template <int dim>

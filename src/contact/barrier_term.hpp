@@ -26,7 +26,7 @@ class BarrierTerm : public EnergyTerm<dim> {
   // New step: particle stencils of this step, pairs near x^n (the graph's).
   void begin_step(const ParticleStencils<dim>& ps, ConstDofView x);
 
-  void add_couplings(std::vector<long long>& keys, LO n_nodes) const override;
+  void add_couplings(NodeGraphBuilder& graph) const override;
   // Changes when this step's pairs (with their particles' stencils) differ
   // from those the graph was built with, or update() grew the graph.
   std::uint64_t couplings_version() const override { return version_; }
@@ -89,8 +89,7 @@ class BarrierTerm : public EnergyTerm<dim> {
   mutable LO n_pairs_ = 0;
   mutable Kokkos::View<LO*, MemSpace> segments_;  // n_segments_ + 1 starts into pairs_ (capacity grows)
   mutable LO n_segments_ = 0;
-  mutable std::vector<long long> graph_keys_;  // q * n_prims + j, sorted
-  mutable Kokkos::View<long long*, MemSpace> graph_keys_dev_;
+  mutable Kokkos::View<long long*, MemSpace> graph_keys_dev_;  // the graph's pairs: q * n_prims + j, sorted
   // (pair key, stencil base) of each begin_step pair, in the broad phase's
   // (sorted) order: this step's, and those the graph was last asked for.
   Kokkos::View<long long* [2], MemSpace> signature_dev_, graph_signature_;

@@ -87,14 +87,13 @@ LO FrictionTerm<dim>::update_lagged(ConstDofView x, ConstDofView x_ref, double s
 }
 
 template <int dim>
-void FrictionTerm<dim>::add_couplings(std::vector<long long>& keys, LO n_nodes) const {
+void FrictionTerm<dim>::add_couplings(NodeGraphBuilder& graph) const {
   const auto& ps = barrier_.particles();
   const auto& prims = barrier_.primitives();
-  auto pn = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), ps.nodes);
-  auto vn = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), prims.nodes);
-  auto vc = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), prims.count);
-  auto pr = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), pair_);
-  for (LO k = 0; k < n_; ++k) add_pair_couplings(pn, vn, vc, pr(k, 0), pr(k, 1), n_nodes, true, keys);
+  const auto pair = pair_;  // the barrier's order: by particle
+  add_pair_couplings(
+      graph, n_, KOKKOS_LAMBDA(const long k) { return pair(k, 0); }, KOKKOS_LAMBDA(const long k) { return pair(k, 1); },
+      ps.nodes, prims.nodes, prims.count);
 }
 
 // The sliding displacement u_k = T_k^T sum_i c_ki s (x_i - x_ref,i) of each

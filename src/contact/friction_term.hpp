@@ -31,7 +31,7 @@ class FrictionTerm : public EnergyTerm<dim> {
   void clear() { n_ = 0; }
   LO pairs() const { return n_; }
 
-  void add_couplings(std::vector<long long>& keys, LO n_nodes) const override;
+  void add_couplings(NodeGraphBuilder& graph) const override;
   double energy(ConstDofView x) const override;
   void gradient(ConstDofView x, double scale, DofView grad) const override;
   void assemble(ConstDofView x, const Sink<dim>& sink) const override;

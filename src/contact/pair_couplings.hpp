@@ -1,30 +1,40 @@
 #pragma once
-// Graph couplings of a contact pair (particle q, primitive j): every grid node
-// of the particle's stencil with every vertex (both orders), and the vertices
-// among themselves; with `stencil_block` also the stencil's own block (the
-// MPM elasticity has it too; a term asks for it once per particle so that it
-// never relies on another term's graph entries).
-#include <vector>
-
+// Graph couplings of contact pairs (particle q, primitive j): every grid node
+// of the particle's stencil with every vertex of the primitive (both orders),
+// the vertices among themselves, and the stencil's own block (the MPM
+// elasticity has it too; a contact term declares it itself so that it never
+// relies on another term's graph entries), declared once per run of pairs of
+// the same particle (pairs sorted by particle declare it once per particle).
+//
+// n pairs; pair k is (q_of(k), j_of(k)). pn: the particles' stencil nodes
+// (n_particles x ns); vn, vc: the primitives' vertices and vertex counts.
 #include "core/types.hpp"
+#include "kernels/node_graph.hpp"
 
 namespace bfemp {
 
-template <class StencilNodes, class PrimNodes, class PrimCount>
-void add_pair_couplings(const StencilNodes& pn, const PrimNodes& vn, const PrimCount& vc, LO q, LO j, LO n_nodes,
-                        bool stencil_block, std::vector<long long>& keys) {
-  const long long N = n_nodes;
-  if (stencil_block)
-    for (std::size_t a = 0; a < pn.extent(1); ++a)
-      for (std::size_t b = 0; b < pn.extent(1); ++b) keys.push_back(pn(q, a) * N + pn(q, b));
-  for (int i = 0; i < vc(j); ++i) {
-    const long long v = vn(j, i);
-    for (std::size_t a = 0; a < pn.extent(1); ++a) {
-      keys.push_back(pn(q, a) * N + v);
-      keys.push_back(v * N + pn(q, a));
-    }
-    for (int k = 0; k < vc(j); ++k) keys.push_back(v * N + vn(j, k));
-  }
+template <class QOf, class JOf, class StencilNodes, class PrimNodes, class PrimCount>
+void add_pair_couplings(NodeGraphBuilder& graph, long n, QOf q_of, JOf j_of, const StencilNodes& pn,
+                        const PrimNodes& vn, const PrimCount& vc) {
+  const int ns = static_cast<int>(pn.extent(1));
+  const int nv = static_cast<int>(vn.extent(1));
+  graph.add_cliques(n, ns, KOKKOS_LAMBDA(const long k, const int a) {
+    const LO q = q_of(k);
+    return k > 0 && q_of(k - 1) == q ? LO(-1) : pn(q, a);
+  });
+  // rows: the stencil and the vertices; columns: the vertices (and back)
+  graph.add_products(
+      n, ns + nv, nv,
+      KOKKOS_LAMBDA(const long k, const int a) {
+        const LO j = j_of(k);
+        if (a < ns) return pn(q_of(k), a);
+        return a - ns < vc(j) ? vn(j, a - ns) : LO(-1);
+      },
+      KOKKOS_LAMBDA(const long k, const int b) {
+        const LO j = j_of(k);
+        return b < vc(j) ? vn(j, b) : LO(-1);
+      },
+      true);
 }
 
 }  // namespace bfemp

@@ -13,20 +13,22 @@
 #include <cmath>
 #include <limits>
 #include <stdexcept>
-#include <unordered_set>
 
 namespace bfemp {
 
 template <int dim>
-void MpmElasticityTerm<dim>::add_couplings(std::vector<long long>& keys, LO n_nodes) const {
+void MpmElasticityTerm<dim>::add_couplings(NodeGraphBuilder& graph) const {
   constexpr int ns = bspline_stencil_size<dim>;
-  auto nodes = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), this->stencils().nodes);
-  std::unordered_set<LO> seen;  // a stencil is identified by its first node
-  for (std::size_t q = 0; q < nodes.extent(0); ++q) {
-    if (!seen.insert(nodes(q, 0)).second) continue;
-    for (int a = 0; a < ns; ++a)
-      for (int b = 0; b < ns; ++b) keys.push_back(static_cast<long long>(nodes(q, a)) * n_nodes + nodes(q, b));
+  if (cells_.order.extent(0) != static_cast<std::size_t>(this->stencils().size())) {
+    DeformationTerm<dim, ns>::add_couplings(graph);
+    return;
   }
+  const auto nodes = this->stencils().nodes;
+  const auto cells = cells_.cells;
+  const auto start = cells_.start;
+  const auto order = cells_.order;
+  graph.add_cliques(cells_.n_cells, ns,
+                    KOKKOS_LAMBDA(const long k, const int a) { return nodes(order(start(cells(k))), a); });
 }
 
 template <int dim>

@@ -63,7 +63,9 @@ template <int dim>
 class MpmElasticityTerm : public DeformationTerm<dim, bspline_stencil_size<dim>> {
  public:
   using DeformationTerm<dim, bspline_stencil_size<dim>>::DeformationTerm;
-  void add_couplings(std::vector<long long>& keys, LO n_nodes) const override;
+  // One clique per occupied cell (its first particle's stencil); before
+  // set_cells, one per particle.
+  void add_couplings(NodeGraphBuilder& graph) const override;
   std::uint64_t couplings_version() const override { return cells_.version; }
   void assemble(ConstDofView x, const Sink<dim>& sink) const override;
   // The stencil-by-stencil assembly with atomics (the generic path; tests

@@ -134,16 +134,14 @@ template <int dim>
 void DofSpace<dim>::rebuild(const std::string& cause) {
   count_cause(cause);
   Kokkos::Timer timer;
-  std::vector<long long> keys;
-  for (const auto* t : terms_) t->add_couplings(keys, n_nodes_);
   if (!distributed()) {
-    A_ = Teuchos::rcp(new Matrix(build_dof_graph<dim>(keys, n_nodes_, map_)));
+    A_ = Teuchos::rcp(new Matrix(build_dof_graph<dim>(terms_, n_nodes_, map_)));
     A_->fillComplete();
   } else {
     if (slip_.count() > 0) throw std::invalid_argument("slip constraints run on 1 MPI rank only in this version");
     // Overlap graph (local ids), then the owned graph: each owned row holds the
     // union of its rows on all ranks (row lengths summed first: an upper bound).
-    auto G_ov = build_dof_graph<dim>(keys, n_nodes_, overlap_map_, map_);
+    auto G_ov = build_dof_graph<dim>(terms_, n_nodes_, overlap_map_, map_);
     Vector len_ov(overlap_map_), len(map_);
     {
       auto v = len_ov.getLocalViewHost(Tpetra::Access::OverwriteAll);

@@ -13,6 +13,7 @@
 #include "kernels/deformation_energy.hpp"
 #include "solver/stencil_coloring.hpp"
 #include "kernels/dof_sink.hpp"
+#include "kernels/node_graph.hpp"
 #include "solver/tpetra_types.hpp"
 
 namespace bfemp {
@@ -45,8 +46,11 @@ class EnergyTerm {
  public:
   virtual ~EnergyTerm() = default;
   virtual std::string name() const = 0;
-  // Appends node pairs a * n_nodes + b (both orders) the Hessian may touch.
-  virtual void add_couplings(std::vector<long long>& keys, LO n_nodes) const = 0;
+  // Declares the node pairs (both orders) the Hessian may touch, as products
+  // of stencils (kernels/node_graph.hpp), on the device. Called twice per
+  // graph build (the builder's counting and filling passes): it must declare
+  // the same both times. Every node's diagonal block is there without it.
+  virtual void add_couplings(NodeGraphBuilder& graph) const = 0;
   // Changes whenever the couplings add_couplings would give change (the DOF
   // space rebuilds its graph only then).
   virtual std::uint64_t couplings_version() const { return 0; }
@@ -99,11 +103,10 @@ class DeformationTerm : public EnergyTerm<dim> {
   }
   const DeformationStencils<dim, nv>& stencils() const { return s_; }
 
-  void add_couplings(std::vector<long long>& keys, LO n_nodes) const override {
-    auto nodes = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), s_.nodes);
-    for (std::size_t q = 0; q < nodes.extent(0); ++q)
-      for (int a = 0; a < nv; ++a)
-        for (int b = 0; b < nv; ++b) keys.push_back(static_cast<long long>(nodes(q, a)) * n_nodes + nodes(q, b));
+  // Each stencil's nodes, all pairs.
+  void add_couplings(NodeGraphBuilder& graph) const override {
+    const auto nodes = s_.nodes;
+    graph.add_cliques(s_.size(), nv, KOKKOS_LAMBDA(const long q, const int a) { return nodes(q, a); });
   }
   double energy(ConstDofView x) const override { return deformation_energy(s_, x); }
   void gradient(ConstDofView x, double scale, DofView grad) const override {

@@ -173,10 +173,8 @@ template <int dim>
 Assembled assemble_dense(const EnergyTerm<dim>& term, LO n_nodes, Kokkos::View<double*, MemSpace> x, double scale,
                          const std::vector<int>& mask, const HostVec& dx_prescribed, bool project = true) {
   const std::size_t nd = static_cast<std::size_t>(n_nodes) * dim;
-  std::vector<long long> keys;
-  term.add_couplings(keys, n_nodes);
   auto map = Teuchos::rcp(new Map(nd, 0, Tpetra::getDefaultComm()));
-  auto A = Teuchos::rcp(new Matrix(build_dof_graph<dim>(keys, n_nodes, map)));
+  auto A = Teuchos::rcp(new Matrix(build_dof_graph<dim>({&term}, n_nodes, map)));
   A->fillComplete();
   A->resumeFill();
   A->setAllToScalar(0.0);

@@ -7,6 +7,8 @@
 //    atomics, and by cell and color without), with some DOFs prescribed, with
 //    each block found by bisection and through the scatter table; a table
 //    whose stencils changed is refused until set_structure rebuilds it;
+//  - the MPM term's couplings by cell give the graph of every particle's
+//    stencil;
 //  - the graph is cached: a scene whose structure does not change builds it
 //    once, and a direct solver runs its symbolic phase once;
 //  - particle order does not change a run beyond round-off.
@@ -251,6 +253,15 @@ void mpm_case(int n_particles) {
   bin_particles<dim>(grid, p, cells);
   term.set_cells(cells);
   ASSERT_EQ(cells.color_start(ParticleCells<dim>::n_colors), cells.n_cells);
+  {  // the couplings by cell (one stencil per cell) = those of every particle's stencil
+    DeformationTerm<dim, ns> every("every particle", s);
+    auto map = Teuchos::rcp(new Map(static_cast<Tpetra::global_size_t>(n) * dim, 0, Tpetra::getDefaultComm()));
+    const auto by_cell = build_dof_graph<dim>({&term}, n, map)->getLocalGraphHost();
+    const auto by_particle = build_dof_graph<dim>({&every}, n, map)->getLocalGraphHost();
+    ASSERT_EQ(by_cell.row_map.extent(0), by_particle.row_map.extent(0));
+    for (std::size_t r = 0; r <= static_cast<std::size_t>(n) * dim; ++r) ASSERT_EQ(by_cell.row_map(r), by_particle.row_map(r));
+    for (std::size_t k = 0; k < by_cell.entries.extent(0); ++k) ASSERT_EQ(by_cell.entries(k), by_particle.entries(k));
+  }
   const std::size_t nd = static_cast<std::size_t>(n) * dim;
   Kokkos::View<double*, MemSpace> x("x", nd);
   std::uniform_real_distribution<double> disp(-0.003, 0.003);

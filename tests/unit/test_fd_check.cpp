@@ -39,11 +39,14 @@ class TestTerm : public EnergyTerm<2> {
     for (int i = 0; i < nd; ++i) c_[i] = 0.3 + 0.1 * i;
   }
   std::string name() const override { return "test"; }
-  void add_couplings(std::vector<long long>& keys, LO n_nodes) const override {
-    for (int a = 0; a < 4; ++a)
-      for (int b = 0; b < 4; ++b)
-        if (!(bug_ == Bug::missing_coupling && ((a == 2 && b == 3) || (a == 3 && b == 2))))
-          keys.push_back(static_cast<long long>(a) * n_nodes + b);
+  // Nodes 0..3 all coupled, but for the missing_coupling bug: (2, 3) and (3, 2).
+  void add_couplings(NodeGraphBuilder& graph) const override {
+    const bool missing = bug_ == Bug::missing_coupling;
+    graph.add_products(
+        4, 1, 4, KOKKOS_LAMBDA(const long s, int) { return LO(s); },
+        KOKKOS_LAMBDA(const long s, const int b) {
+          return missing && ((s == 2 && b == 3) || (s == 3 && b == 2)) ? LO(-1) : LO(b);
+        });
   }
   double energy(ConstDofView x) const override {
     double e = 0;

@@ -32,7 +32,7 @@ constexpr double kEh = 1e-7;   // eps_v dt (m)
 class KinkTerm : public EnergyTerm<2> {
  public:
   std::string name() const override { return "kink"; }
-  void add_couplings(std::vector<long long>& keys, LO) const override { keys.push_back(0); }
+  void add_couplings(NodeGraphBuilder&) const override {}  // node 0's diagonal block only
   double energy(ConstDofView x) const override { return kC * friction_f0(std::fabs(x(0)), kEh); }
   void gradient(ConstDofView x, double scale, DofView grad) const override {
     grad(0) += scale * kC * friction_f1_over_y(std::fabs(x(0)), kEh) * x(0);
