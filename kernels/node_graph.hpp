@@ -13,16 +13,19 @@
 // Two passes over the same declarations: counting (each row's entries,
 // repeats included, atomic adds), then filling (each row's cursor, atomic
 // fetch-adds). finish() sorts each row and drops the repeats (KokkosKernels'
-// sort_and_merge_graph: a radix sort per row, rows in parallel), giving the
-// node graph as CRS (row pointers, sorted unique columns). Everything runs on
-// ExecSpace; the host reads one number, the entry count, to allocate.
+// sort_and_merge_graph: a radix sort per row on host execution spaces, a
+// team bitonic sort on GPUs; rows in parallel), giving the node graph as CRS
+// (row pointers, sorted unique columns). Everything runs on ExecSpace; the
+// host reads a few numbers (the entry counts, the checks below).
 //
 // Memory: the unmerged entries, sum over items of (valid rows x valid
-// columns), 4 bytes each (a 3D MPM cell of 27 nodes: 729), plus as many
-// again for the sort's scratch.
+// columns), 4 bytes each (a 3D MPM cell of 27 nodes: 729), as many again for
+// the sort's scratch, 4 bytes per merged entry, and three arrays of
+// n_nodes + 1 row pointers (8 bytes each).
 //
-// Preconditions: node ids in [0, n_nodes); the same declarations, in any
-// order, in both passes (terms are const between them).
+// Preconditions, checked (std::logic_error, before any entry is written out
+// of its row): node ids < n_nodes; the same declarations, in any order, in
+// both passes (terms are const between them): every row filled exactly.
 #include <Kokkos_Core.hpp>
 #include <KokkosKernels_SparseUtils.hpp>
 #include <cstddef>
@@ -38,7 +41,8 @@ class NodeGraphBuilder {
   using RowMap = Kokkos::View<std::size_t*, MemSpace>;
   using Entries = Kokkos::View<LO*, MemSpace>;
 
-  explicit NodeGraphBuilder(LO n_nodes) : n_nodes_(n_nodes), rows_("node_graph_rows", n_nodes + 1) {
+  explicit NodeGraphBuilder(LO n_nodes)
+      : n_nodes_(n_nodes), rows_("node_graph_rows", n_nodes + 1), out_of_range_("node_graph_out_of_range") {
     const auto rows = rows_;
     Kokkos::parallel_for(
         "node_graph_diagonal_count", Kokkos::RangePolicy<ExecSpace>(0, n_nodes),
@@ -49,52 +53,77 @@ class NodeGraphBuilder {
 
   template <class RowOf, class ColOf>
   void add_products(long n, int wr, int wc, RowOf row_of, ColOf col_of, bool symmetric = false) {
-    if (n <= 0) return;
     if (finished_) throw std::logic_error("NodeGraphBuilder: add_products after finish()");
+    if (n <= 0) return;
     const auto rows = rows_;
     if (counting_) {
+      const LO n_nodes = n_nodes_;
+      const auto bad = out_of_range_;
       Kokkos::parallel_for(
           "node_graph_count", Kokkos::RangePolicy<ExecSpace>(0, n), KOKKOS_LAMBDA(const long s) {
             std::size_t nr = 0, nc = 0;
-            for (int b = 0; b < wc; ++b) nc += col_of(s, b) >= 0 ? 1 : 0;
-            for (int a = 0; a < wr; ++a) {
-              const LO r = row_of(s, a);
-              if (r < 0) continue;
-              ++nr;
-              Kokkos::atomic_add(&rows(r), nc);
-            }
-            if (!symmetric) return;
             for (int b = 0; b < wc; ++b) {
               const LO c = col_of(s, b);
-              if (c >= 0) Kokkos::atomic_add(&rows(c), nr);
+              if (c >= n_nodes) Kokkos::atomic_assign(&bad(), 1);
+              nc += c >= 0 && c < n_nodes ? 1 : 0;
+            }
+            for (int a = 0; a < wr; ++a) {
+              const LO r = row_of(s, a);
+              if (r >= n_nodes) Kokkos::atomic_assign(&bad(), 1);
+              if (r < 0 || r >= n_nodes) continue;
+              ++nr;
+              if (nc > 0) Kokkos::atomic_add(&rows(r), nc);
+            }
+            if (!symmetric || nr == 0) return;
+            for (int b = 0; b < wc; ++b) {
+              const LO c = col_of(s, b);
+              if (c >= 0 && c < n_nodes) Kokkos::atomic_add(&rows(c), nr);
             }
           });
       return;
     }
     const auto cursor = cursor_;
     const auto entries = raw_;
+    const auto bad = overflow_;
+    const LO n_nodes = n_nodes_;
     Kokkos::parallel_for(
         "node_graph_fill", Kokkos::RangePolicy<ExecSpace>(0, n), KOKKOS_LAMBDA(const long s) {
           std::size_t nr = 0, nc = 0;
-          for (int b = 0; b < wc; ++b) nc += col_of(s, b) >= 0 ? 1 : 0;
-          for (int a = 0; a < wr; ++a) nr += row_of(s, a) >= 0 ? 1 : 0;
-          for (int a = 0; a < wr; ++a) {
-            const LO r = row_of(s, a);
-            if (r < 0) continue;
-            std::size_t p = Kokkos::atomic_fetch_add(&cursor(r), nc);
-            for (int b = 0; b < wc; ++b) {
-              const LO c = col_of(s, b);
-              if (c >= 0) entries(p++) = c;
-            }
-          }
-          if (!symmetric) return;
           for (int b = 0; b < wc; ++b) {
             const LO c = col_of(s, b);
-            if (c < 0) continue;
+            if (c >= n_nodes) Kokkos::atomic_assign(&bad(), 1);
+            nc += c >= 0 && c < n_nodes ? 1 : 0;
+          }
+          for (int a = 0; a < wr; ++a) {
+            const LO r = row_of(s, a);
+            if (r >= n_nodes) Kokkos::atomic_assign(&bad(), 1);
+            nr += r >= 0 && r < n_nodes ? 1 : 0;
+          }
+          for (int a = 0; a < wr; ++a) {
+            const LO r = row_of(s, a);
+            if (r < 0 || r >= n_nodes || nc == 0) continue;
+            std::size_t p = Kokkos::atomic_fetch_add(&cursor(r), nc);
+            if (p + nc > rows(r + 1)) {  // more than counted: declared differently
+              Kokkos::atomic_assign(&bad(), 1);
+              continue;
+            }
+            for (int b = 0; b < wc; ++b) {
+              const LO c = col_of(s, b);
+              if (c >= 0 && c < n_nodes) entries(p++) = c;
+            }
+          }
+          if (!symmetric || nr == 0) return;
+          for (int b = 0; b < wc; ++b) {
+            const LO c = col_of(s, b);
+            if (c < 0 || c >= n_nodes) continue;
             std::size_t p = Kokkos::atomic_fetch_add(&cursor(c), nr);
+            if (p + nr > rows(c + 1)) {
+              Kokkos::atomic_assign(&bad(), 1);
+              continue;
+            }
             for (int a = 0; a < wr; ++a) {
               const LO r = row_of(s, a);
-              if (r >= 0) entries(p++) = r;
+              if (r >= 0 && r < n_nodes) entries(p++) = r;
             }
           }
         });
@@ -109,6 +138,10 @@ class NodeGraphBuilder {
   void start_fill() {
     if (!counting_) throw std::logic_error("NodeGraphBuilder: start_fill twice");
     counting_ = false;
+    int out_of_range = 0;
+    Kokkos::deep_copy(out_of_range, out_of_range_);
+    if (out_of_range)
+      throw std::logic_error("NodeGraphBuilder: a term declared a node id >= n_nodes = " + std::to_string(n_nodes_));
     const auto rows = rows_;
     const LO n = n_nodes_;
     std::size_t total = 0;
@@ -122,6 +155,7 @@ class NodeGraphBuilder {
         total);
     raw_ = Entries(Kokkos::ViewAllocateWithoutInitializing("node_graph_raw"), total);
     cursor_ = RowMap(Kokkos::ViewAllocateWithoutInitializing("node_graph_cursor"), n);
+    overflow_ = Kokkos::View<int, MemSpace>("node_graph_overflow");
     const auto cursor = cursor_;
     const auto raw = raw_;
     Kokkos::parallel_for(
@@ -132,10 +166,25 @@ class NodeGraphBuilder {
   }
 
   // The node graph: rows sorted, repeats dropped. `rowmap` has n_nodes + 1
-  // entries.
+  // entries. Throws std::logic_error when the filling pass did not fill
+  // every row exactly as counted.
   void finish(RowMap& rowmap, Entries& entries) {
     if (counting_) throw std::logic_error("NodeGraphBuilder: finish before start_fill");
+    if (finished_) throw std::logic_error("NodeGraphBuilder: finish twice");
     finished_ = true;
+    const auto rows = rows_;
+    const auto cursor = cursor_;
+    const auto overflow = overflow_;
+    LO unfilled = 0;
+    Kokkos::parallel_reduce(
+        "node_graph_check", Kokkos::RangePolicy<ExecSpace>(0, n_nodes_),
+        KOKKOS_LAMBDA(const LO i, LO& acc) { acc += cursor(i) != rows(i + 1) ? 1 : 0; }, unfilled);
+    int overflowed = 0;
+    Kokkos::deep_copy(overflowed, overflow);
+    if (overflowed || unfilled)
+      throw std::logic_error("NodeGraphBuilder: the filling pass declared other couplings than the counting pass (" +
+                             std::to_string(unfilled) + " rows not filled as counted" +
+                             (overflowed ? ", some overfilled)" : ")"));
     if (n_nodes_ == 0) {
       rowmap = RowMap("node_graph_rowmap", 1);
       entries = Entries();
@@ -152,6 +201,8 @@ class NodeGraphBuilder {
   RowMap rows_;    // counts, then the unmerged row pointers
   RowMap cursor_;  // each row's next free entry while filling
   Entries raw_;    // the unmerged entries
+  Kokkos::View<int, MemSpace> out_of_range_;  // counting: a node id >= n_nodes seen
+  Kokkos::View<int, MemSpace> overflow_;      // filling: a row got more than counted
 };
 
 }  // namespace bfemp

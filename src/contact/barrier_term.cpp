@@ -164,7 +164,8 @@ bool BarrierTerm<dim>::update(ConstDofView x) const {
       },
       missing);
   if (missing == 0) return false;
-  // The graph's keys and these pairs', sorted, without repeats (on the device).
+  // The graph's keys and these pairs', sorted (Kokkos::sort: std::sort on a
+  // host execution space), without repeats (a parallel scan).
   const long long n_all = nk + n_pairs_;
   Kokkos::View<long long*, MemSpace> all(Kokkos::ViewAllocateWithoutInitializing("contact_graph_keys_all"), n_all);
   Kokkos::parallel_for(

@@ -22,19 +22,14 @@ void add_pair_couplings(NodeGraphBuilder& graph, long n, QOf q_of, JOf j_of, con
     const LO q = q_of(k);
     return k > 0 && q_of(k - 1) == q ? LO(-1) : pn(q, a);
   });
-  // rows: the stencil and the vertices; columns: the vertices (and back)
+  const auto vertex = KOKKOS_LAMBDA(const long k, const int b) {
+    const LO j = j_of(k);
+    return b < vc(j) ? vn(j, b) : LO(-1);
+  };
+  // the stencil with the vertices, both ways; the vertices among themselves
   graph.add_products(
-      n, ns + nv, nv,
-      KOKKOS_LAMBDA(const long k, const int a) {
-        const LO j = j_of(k);
-        if (a < ns) return pn(q_of(k), a);
-        return a - ns < vc(j) ? vn(j, a - ns) : LO(-1);
-      },
-      KOKKOS_LAMBDA(const long k, const int b) {
-        const LO j = j_of(k);
-        return b < vc(j) ? vn(j, b) : LO(-1);
-      },
-      true);
+      n, ns, nv, KOKKOS_LAMBDA(const long k, const int a) { return pn(q_of(k), a); }, vertex, true);
+  graph.add_cliques(n, nv, vertex);
 }
 
 }  // namespace bfemp

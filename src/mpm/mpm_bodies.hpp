@@ -63,8 +63,8 @@ template <int dim>
 class MpmElasticityTerm : public DeformationTerm<dim, bspline_stencil_size<dim>> {
  public:
   using DeformationTerm<dim, bspline_stencil_size<dim>>::DeformationTerm;
-  // One clique per occupied cell (its first particle's stencil); before
-  // set_cells, one per particle.
+  // One clique per occupied cell (its first particle's stencil); one per
+  // particle when the cells do not match the stencils (before set_cells).
   void add_couplings(NodeGraphBuilder& graph) const override;
   std::uint64_t couplings_version() const override { return cells_.version; }
   void assemble(ConstDofView x, const Sink<dim>& sink) const override;

@@ -165,6 +165,42 @@ TEST(ContactPotentials, BarrierDerivatives3D) {
   fixtures::check_exact_term<3>(barrier, s.n_nodes, s.x, kFdStep, 1e-5);
 }
 
+// The graph's pairs grow mid-step: update() at an iterate where a particle
+// came within reach of an edge that begin_step did not pair it with. The
+// merged pairs are sorted and without repeats (a second update at the same
+// x finds none missing), and a graph built from the couplings then holds
+// every block the assembly writes (gradient and exact Hessian against
+// differences, entry by entry).
+TEST(ContactPotentials, GraphGrowsByTheMissingPairs) {
+  // particle 1 within dhat (0.1) of the top edge; particle 0 0.6 above it,
+  // beyond the graph's reach at the step's start (Contact's margin: 4 dhat),
+  // its stencil (nodes y = 1.5 .. 1.7) apart from particle 1's (0.9 .. 1.1).
+  // The new pairs (particle 0) sort before the graph's (particle 1).
+  auto s = make_scene<2>({Vec<2>(0.3, 1.6), Vec<2>(0.5, 1.03)}, params(0.1));
+  auto& barrier = const_cast<BarrierTerm<2>&>(*s.contact->barrier());
+  const auto v0 = barrier.couplings_version();
+  EXPECT_FALSE(barrier.update(s.x));
+  EXPECT_EQ(barrier.couplings_version(), v0);
+  // the grid nodes above y = 1.45 move down by 0.55: particle 0 to y = 1.05
+  Kokkos::View<double*, MemSpace> x2("x2", s.x.extent(0));
+  Kokkos::deep_copy(x2, s.x);
+  const LO nF = s.mesh.num_nodes();
+  for (LO i = nF; i < s.n_nodes; ++i)
+    if (x2(2 * i + 1) > 1.45) x2(2 * i + 1) -= 0.55;
+  perturb<2>(x2, 1e-3, 13);
+  EXPECT_TRUE(barrier.update(x2));
+  EXPECT_NE(barrier.couplings_version(), v0);
+  const auto v1 = barrier.couplings_version();
+  EXPECT_FALSE(barrier.update(x2)) << "the grown keys do not hold this iterate's pairs (unsorted or lost)";
+  EXPECT_EQ(barrier.couplings_version(), v1);
+  EXPECT_FALSE(barrier.update(s.x)) << "the pairs of the step's start are missing";
+  EXPECT_FALSE(barrier.update(x2));
+  barrier.set_projection(false);
+  ASSERT_GT(barrier.energy(x2), 0.0);
+  fixtures::check_energy_term<2>(barrier, s.n_nodes, x2, kFdStep, 1e-5);
+  barrier.set_projection(true);
+}
+
 // Scene with friction (mu 0.4) lagged at a perturbed x, against a reference
 // perturbed by `slide` (the step's sliding displacement x - x_ref).
 template <int dim>

@@ -6,7 +6,10 @@
 //  - the filling pass may see the declarations in another order;
 //  - the DOF graph holds, in DOF row (i, c), node i's columns in order, each
 //    as dim consecutive DOFs;
-//  - no nodes, or no items, are legal.
+//  - no nodes, or no items, are legal;
+//  - a filling pass that declares fewer or more couplings than the counting
+//    pass, or a node id >= n_nodes, is refused (std::logic_error) before a
+//    graph comes out.
 #include <gtest/gtest.h>
 
 #include <Tpetra_Core.hpp>
@@ -143,6 +146,48 @@ TEST(NodeGraph, NoNodesAndNoCouplings) {
   for (LO i = 0; i < 7; ++i) diagonal.insert({i, i});
   expect_graph(rows, cols, 7, diagonal);
   EXPECT_THROW(g.start_fill(), std::logic_error);
+}
+
+TEST(NodeGraph, DeclarationsThatDifferBetweenPassesAreRefused) {
+  const LO n_nodes = 40;
+  std::mt19937 rng(23);
+  const auto d = random_declaration(rng, n_nodes, 20, 3, 3, true, false);
+  const auto fewer = random_declaration(rng, n_nodes, 0, 3, 3, true, false);
+  const auto extra = random_declaration(rng, n_nodes, 5, 3, 3, true, false);
+  NodeGraphBuilder::RowMap rows;
+  NodeGraphBuilder::Entries cols;
+  {  // the fill declares nothing: rows left unfilled
+    NodeGraphBuilder g(n_nodes);
+    declare(g, d);
+    g.start_fill();
+    declare(g, fewer);
+    EXPECT_THROW(g.finish(rows, cols), std::logic_error);
+  }
+  {  // the fill declares more: rows overfilled (refused before writing past them)
+    NodeGraphBuilder g(n_nodes);
+    declare(g, d);
+    g.start_fill();
+    declare(g, d);
+    declare(g, extra);
+    EXPECT_THROW(g.finish(rows, cols), std::logic_error);
+  }
+  {  // the same declarations: a graph, and finish() only once
+    NodeGraphBuilder g(n_nodes);
+    declare(g, d);
+    g.start_fill();
+    declare(g, d);
+    EXPECT_NO_THROW(g.finish(rows, cols));
+    EXPECT_THROW(g.finish(rows, cols), std::logic_error);
+    EXPECT_THROW(declare(g, d), std::logic_error);
+  }
+  {  // a node id past the last node
+    NodeGraphBuilder g(n_nodes);
+    Kokkos::View<LO**, MemSpace> nodes("nodes", 1, 2);
+    nodes(0, 0) = 3;
+    nodes(0, 1) = n_nodes;
+    g.add_cliques(1, 2, KOKKOS_LAMBDA(const long s, const int a) { return nodes(s, a); });
+    EXPECT_THROW(g.start_fill(), std::logic_error);
+  }
 }
 
 template <int dim>
