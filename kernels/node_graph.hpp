@@ -61,18 +61,11 @@ class NodeGraphBuilder {
       const auto bad = out_of_range_;
       Kokkos::parallel_for(
           "node_graph_count", Kokkos::RangePolicy<ExecSpace>(0, n), KOKKOS_LAMBDA(const long s) {
-            std::size_t nr = 0, nc = 0;
-            for (int b = 0; b < wc; ++b) {
-              const LO c = col_of(s, b);
-              if (c >= n_nodes) Kokkos::atomic_assign(&bad(), 1);
-              nc += c >= 0 && c < n_nodes ? 1 : 0;
-            }
-            for (int a = 0; a < wr; ++a) {
+            const std::size_t nc = valid_nodes(col_of, s, wc, n_nodes, bad);
+            const std::size_t nr = valid_nodes(row_of, s, wr, n_nodes, bad);
+            for (int a = 0; a < wr && nc > 0; ++a) {
               const LO r = row_of(s, a);
-              if (r >= n_nodes) Kokkos::atomic_assign(&bad(), 1);
-              if (r < 0 || r >= n_nodes) continue;
-              ++nr;
-              if (nc > 0) Kokkos::atomic_add(&rows(r), nc);
+              if (r >= 0 && r < n_nodes) Kokkos::atomic_add(&rows(r), nc);
             }
             if (!symmetric || nr == 0) return;
             for (int b = 0; b < wc; ++b) {
@@ -88,17 +81,8 @@ class NodeGraphBuilder {
     const LO n_nodes = n_nodes_;
     Kokkos::parallel_for(
         "node_graph_fill", Kokkos::RangePolicy<ExecSpace>(0, n), KOKKOS_LAMBDA(const long s) {
-          std::size_t nr = 0, nc = 0;
-          for (int b = 0; b < wc; ++b) {
-            const LO c = col_of(s, b);
-            if (c >= n_nodes) Kokkos::atomic_assign(&bad(), 1);
-            nc += c >= 0 && c < n_nodes ? 1 : 0;
-          }
-          for (int a = 0; a < wr; ++a) {
-            const LO r = row_of(s, a);
-            if (r >= n_nodes) Kokkos::atomic_assign(&bad(), 1);
-            nr += r >= 0 && r < n_nodes ? 1 : 0;
-          }
+          const std::size_t nc = valid_nodes(col_of, s, wc, n_nodes, bad);
+          const std::size_t nr = valid_nodes(row_of, s, wr, n_nodes, bad);
           for (int a = 0; a < wr; ++a) {
             const LO r = row_of(s, a);
             if (r < 0 || r >= n_nodes || nc == 0) continue;
@@ -196,6 +180,19 @@ class NodeGraphBuilder {
   }
 
  private:
+  // The nodes of item s in [0, n_nodes); a node >= n_nodes raises `bad`.
+  template <class NodeOf>
+  KOKKOS_INLINE_FUNCTION static std::size_t valid_nodes(const NodeOf& node_of, long s, int w, LO n_nodes,
+                                                        const Kokkos::View<int, MemSpace>& bad) {
+    std::size_t k = 0;
+    for (int a = 0; a < w; ++a) {
+      const LO v = node_of(s, a);
+      if (v >= n_nodes) Kokkos::atomic_assign(&bad(), 1);
+      k += v >= 0 && v < n_nodes ? 1 : 0;
+    }
+    return k;
+  }
+
   LO n_nodes_;
   bool counting_ = true, finished_ = false;
   RowMap rows_;    // counts, then the unmerged row pointers
