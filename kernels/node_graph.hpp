@@ -55,61 +55,22 @@ class NodeGraphBuilder {
   void add_products(long n, int wr, int wc, RowOf row_of, ColOf col_of, bool symmetric = false) {
     if (finished_) throw std::logic_error("NodeGraphBuilder: add_products after finish()");
     if (n <= 0) return;
+    const bool counting = counting_;
+    const LO n_nodes = n_nodes_;
     const auto rows = rows_;
-    if (counting_) {
-      const LO n_nodes = n_nodes_;
-      const auto bad = out_of_range_;
-      Kokkos::parallel_for(
-          "node_graph_count", Kokkos::RangePolicy<ExecSpace>(0, n), KOKKOS_LAMBDA(const long s) {
-            const std::size_t nc = valid_nodes(col_of, s, wc, n_nodes, bad);
-            const std::size_t nr = valid_nodes(row_of, s, wr, n_nodes, bad);
-            for (int a = 0; a < wr && nc > 0; ++a) {
-              const LO r = row_of(s, a);
-              if (r >= 0 && r < n_nodes) Kokkos::atomic_add(&rows(r), nc);
-            }
-            if (!symmetric || nr == 0) return;
-            for (int b = 0; b < wc; ++b) {
-              const LO c = col_of(s, b);
-              if (c >= 0 && c < n_nodes) Kokkos::atomic_add(&rows(c), nr);
-            }
-          });
-      return;
-    }
     const auto cursor = cursor_;
     const auto entries = raw_;
-    const auto bad = overflow_;
-    const LO n_nodes = n_nodes_;
+    const auto bad = counting ? out_of_range_ : overflow_;
     Kokkos::parallel_for(
-        "node_graph_fill", Kokkos::RangePolicy<ExecSpace>(0, n), KOKKOS_LAMBDA(const long s) {
+        counting ? "node_graph_count" : "node_graph_fill", Kokkos::RangePolicy<ExecSpace>(0, n),
+        KOKKOS_LAMBDA(const long s) {
           const std::size_t nc = valid_nodes(col_of, s, wc, n_nodes, bad);
           const std::size_t nr = valid_nodes(row_of, s, wr, n_nodes, bad);
-          for (int a = 0; a < wr; ++a) {
-            const LO r = row_of(s, a);
-            if (r < 0 || r >= n_nodes || nc == 0) continue;
-            std::size_t p = Kokkos::atomic_fetch_add(&cursor(r), nc);
-            if (p + nc > rows(r + 1)) {  // more than counted: declared differently
-              Kokkos::atomic_assign(&bad(), 1);
-              continue;
-            }
-            for (int b = 0; b < wc; ++b) {
-              const LO c = col_of(s, b);
-              if (c >= 0 && c < n_nodes) entries(p++) = c;
-            }
-          }
-          if (!symmetric || nr == 0) return;
-          for (int b = 0; b < wc; ++b) {
-            const LO c = col_of(s, b);
-            if (c < 0 || c >= n_nodes) continue;
-            std::size_t p = Kokkos::atomic_fetch_add(&cursor(c), nr);
-            if (p + nr > rows(c + 1)) {
-              Kokkos::atomic_assign(&bad(), 1);
-              continue;
-            }
-            for (int a = 0; a < wr; ++a) {
-              const LO r = row_of(s, a);
-              if (r >= 0 && r < n_nodes) entries(p++) = r;
-            }
-          }
+          for (int a = 0; a < wr; ++a)
+            add_row(row_of(s, a), nc, col_of, s, wc, n_nodes, counting, rows, cursor, entries, bad);
+          if (!symmetric) return;
+          for (int b = 0; b < wc; ++b)
+            add_row(col_of(s, b), nr, row_of, s, wr, n_nodes, counting, rows, cursor, entries, bad);
         });
   }
   template <class NodeOf>
@@ -191,6 +152,29 @@ class NodeGraphBuilder {
       k += v >= 0 && v < n_nodes ? 1 : 0;
     }
     return k;
+  }
+
+  // Row r gets the k valid nodes of item s's list: counted (counting), or
+  // written at the row's cursor (filling; a row that would get more than
+  // counted raises `bad` and gets nothing).
+  template <class ListOf>
+  KOKKOS_INLINE_FUNCTION static void add_row(LO r, std::size_t k, const ListOf& list_of, long s, int w, LO n_nodes,
+                                             bool counting, const RowMap& rows, const RowMap& cursor,
+                                             const Entries& entries, const Kokkos::View<int, MemSpace>& bad) {
+    if (r < 0 || r >= n_nodes || k == 0) return;
+    if (counting) {
+      Kokkos::atomic_add(&rows(r), k);
+      return;
+    }
+    std::size_t p = Kokkos::atomic_fetch_add(&cursor(r), k);
+    if (p + k > rows(r + 1)) {
+      Kokkos::atomic_assign(&bad(), 1);
+      return;
+    }
+    for (int b = 0; b < w; ++b) {
+      const LO c = list_of(s, b);
+      if (c >= 0 && c < n_nodes) entries(p++) = c;
+    }
   }
 
   LO n_nodes_;
