@@ -191,7 +191,7 @@ static bool cg_on_old_factor(CholmodDirect::Reuse reuse, cholmod_common& c, chol
   return false;
 }
 
-CholmodDirect::Result CholmodDirect::solve(const Vector& b, Vector& x) {
+CholmodDirect::Result CholmodDirect::solve(const Vector& b, Vector& x, double tolerance) {
   auto& m = *impl_;
   if (m.A.is_null()) throw std::logic_error("CholmodDirect::solve before set_matrix");
   Result res;
@@ -199,11 +199,13 @@ CholmodDirect::Result CholmodDirect::solve(const Vector& b, Vector& x) {
     Kokkos::Timer cg_timer;
     Reuse r = m.reuse;
     r.max_iterations = m.budget;
+    r.tolerance = std::max(r.tolerance, tolerance);
     res.cg_budget = m.budget;
     const bool ok = cg_on_old_factor(r, m.c, m.L, m.X, m.Y, m.E, *m.A, b, m.cg_x, m.cg_r, m.cg_z, m.cg_p,
                                      m.cg_q, res.cg_iterations);
     res.cg_s = cg_timer.seconds();
     if (ok) {
+      res.tolerance = r.tolerance;
       auto xv = x.getLocalViewDevice(Tpetra::Access::OverwriteAll);
       const auto cx = m.cg_x;
       Kokkos::parallel_for("cholmod_cg_out", Kokkos::RangePolicy<ExecSpace>(0, cx.extent(0)),

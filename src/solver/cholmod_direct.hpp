@@ -24,8 +24,9 @@
 // iteration is not told that A is indefinite (the line search still demands
 // descent). Once a factorisation has failed on a non-positive pivot, later
 // factorisations of that time step go into a spare factor, so the last good one survives the
-// next failure (memory: twice the factor). CG's result counts as exact (the
-// solve reports tolerance 0), at the reuse tolerance.
+// next failure (memory: twice the factor). solve() reports the relative
+// residual CG stopped at (the reuse tolerance, or the looser one the caller
+// allows: an inexact Newton direction), 0 after a factorisation (exact).
 //
 // The matrix is symmetric (the DOF space eliminates constraints
 // symmetrically), so its CRS arrays read as compressed columns are A itself;
@@ -59,6 +60,9 @@ struct CholmodReuse {
   // Supernodal factors only: a simplicial one (CHOLMOD's choice for sparse
   // factors, flops / nnz(L) < 40) keeps max_iterations.
   bool by_cost = false;
+  // LinearSolver: CG on the previous factor may stop at the Newton forcing
+  // term (solve()'s `tolerance`), not at `tolerance` ('forcing term').
+  bool adaptive = true;
   static constexpr double kBlas3Advantage = 4.0;
   static constexpr int kMaxByCost = 200;
 };
@@ -77,6 +81,7 @@ class CholmodDirect {
     int cg_budget = 0;        // the iteration budget CG had (CholmodReuse::by_cost)
     double factor_s = 0;      // seconds in the symbolic analysis and numeric factorisation
     double cg_s = 0;          // seconds in CG on the previous factor (also when it gave up)
+    double tolerance = 0;     // relative residual the result was solved to (0: factorised, exact)
   };
 
   explicit CholmodDirect(Reuse reuse = {});
@@ -85,7 +90,9 @@ class CholmodDirect {
   void set_matrix(const Teuchos::RCP<const Matrix>& A);
   // Solves A x = b with the current values: CG on the previous factor where
   // reuse allows it, else a numeric factorisation and the triangular solves.
-  Result solve(const Vector& b, Vector& x);
+  // `tolerance` > the reuse tolerance: CG on the previous factor may stop
+  // there (an inexact Newton direction); the factorisation's solve is exact.
+  Result solve(const Vector& b, Vector& x, double tolerance = 0.0);
   // The next solve factorises (a new time step: runs and their restarts then
   // take the same path).
   void forget_factor();

@@ -344,13 +344,19 @@ TEST(Restart, SortedParticlesContinueBitForBit) {
 // written at another's row would differ by O(1)), and the step-by-step
 // Newton counts and contact-pair counts are equal. The frames (written in id
 // order from the sorted run's permuted particles and contact forces) agree
-// in the same way.
+// in the same way. Both runs solve every Newton direction to the reuse
+// tolerance ('forcing term: fixed'): with the adaptive forcing term a CG on
+// the previous factor that stops at a loose tolerance may stop one iteration
+// earlier in one order than in the other, and a step's Newton count then
+// differs by one (43 against 44 at step 2) while every field still agrees
+// to 1e-9; the counts compared here are the sort's, not the forcing term's.
 TEST(ParticleSort, SortedAndUnsortedRunsAgreeToRoundOff) {
-  const Case c{"sort", disk_wall, friction_sets, 1e-3, 12};
+  const std::string exact = friction_sets + " --set 'Linear Solver/Cholmod/forcing term=fixed'";
+  const Case c{"sort", disk_wall, exact, 1e-3, 12};
   const std::string plain = fresh("sort_off"), sorted = fresh("sort_on");
-  ASSERT_EQ(run_bfemp("run " + disk_wall + " " + friction_sets + " " + end_time(c, c.n) + " -o " + plain, plain + ".log"), 0)
+  ASSERT_EQ(run_bfemp("run " + disk_wall + " " + exact + " " + end_time(c, c.n) + " -o " + plain, plain + ".log"), 0)
       << slurp(plain + ".log");
-  ASSERT_EQ(run_bfemp("run " + disk_wall + " " + friction_sets + " --set 'MPM/sort particles every=1' " +
+  ASSERT_EQ(run_bfemp("run " + disk_wall + " " + exact + " --set 'MPM/sort particles every=1' " +
                           end_time(c, c.n) + " -o " + sorted,
                       sorted + ".log"),
             0)

@@ -103,6 +103,48 @@ TEST(CholmodReuse, NearbyValuesAreSolvedByCgOnThePreviousFactor) {
   EXPECT_EQ(third.cg_iterations, 0);
 }
 
+// An inexact Newton direction: CG on the previous factor stops at the
+// tolerance the caller allows, not the reuse tolerance, and says which it
+// reached; a factorisation's solve reports 0 (exact); a tolerance below the
+// reuse tolerance does not tighten it.
+TEST(CholmodReuse, ALooserToleranceStopsCgEarlierAndIsReported) {
+  Fixture f;
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> u(-0.3, 0.3);
+  auto s2 = f.shift;
+  for (double& s : s2) s *= 1.0 + u(rng);
+  auto solve_at = [&](double tol, CholmodDirect::Result& r, Vector& x) {
+    CholmodDirect solver(CholmodReuse{20, 1e-10});
+    solver.set_matrix(f.A);
+    copy_values(*laplacian(f.shift), *f.A);
+    const auto first = solver.solve(f.b, x, tol);
+    EXPECT_TRUE(first.factorised);
+    EXPECT_EQ(first.tolerance, 0.0);
+    copy_values(*laplacian(s2), *f.A);
+    r = solver.solve(f.b, x, tol);
+  };
+  CholmodDirect::Result tight, loose, below;
+  Vector xt(f.A->getRowMap()), xl(f.A->getRowMap()), xb(f.A->getRowMap());
+  solve_at(0.0, tight, xt);
+  solve_at(1e-3, loose, xl);
+  solve_at(1e-14, below, xb);
+  ASSERT_FALSE(tight.factorised);
+  ASSERT_FALSE(loose.factorised);
+  ASSERT_FALSE(below.factorised);
+  EXPECT_EQ(tight.tolerance, 1e-10);
+  EXPECT_EQ(loose.tolerance, 1e-3);
+  EXPECT_EQ(below.tolerance, 1e-10);
+  EXPECT_EQ(below.cg_iterations, tight.cg_iterations);
+  EXPECT_LT(loose.cg_iterations, tight.cg_iterations);
+  EXPECT_GE(loose.cg_iterations, 1);
+  EXPECT_LT(relative_residual(*f.A, xt, f.b), 1e-10);
+  const double rl = relative_residual(*f.A, xl, f.b);
+  EXPECT_LT(rl, 1e-3);
+  EXPECT_GT(rl, 1e-10);  // it did stop early
+  std::printf("  CG on the previous factor: %d iterations to 1e-10, %d to 1e-3 (residual %.2e)\n",
+              tight.cg_iterations, loose.cg_iterations, rl);
+}
+
 TEST(CholmodReuse, FarValuesAreFactorisedAnew) {
   Fixture f;
   CholmodDirect solver(CholmodReuse{20, 1e-10});
@@ -215,43 +257,80 @@ namespace {
 // A soft MPM block falling and spinning (several Newton iterations per step):
 // with reuse the run takes fewer numeric factorisations and follows the same
 // trajectory to the solver tolerance (the Newton iteration counts are equal).
-TEST(CholmodReuse, SceneRunsTheSameTrajectoryWithFewerFactorisations) {
-  auto run = [](int reuse, long& factorisations, std::vector<int>& its) {
-    auto s = fixtures::mpm_block_setup(0.3, Vec<2>(0.5, 0.6), 0.05, 4, 0.0, 1.0, TransferScheme::APIC, 2e4);
-    s.dt = 2e-2;
-    s.gravity = {0.0, -9.81, 0.0};
-    s.newton.eps_d = 1e-9;
-    s.linear_solver.sublist("Cholmod").set("reuse iterations", reuse);
-    auto& p = s.mpm->particles;
-    for (std::size_t q = 0; q < p.v.extent(0); ++q) {  // spin about the centre: 3 rad/s
-      p.v(q, 0) = -3.0 * (p.x(q, 1) - 0.6);
-      p.v(q, 1) = 3.0 * (p.x(q, 0) - 0.5);
-    }
-    Simulation<2> sim(s, fixtures::comm());
-    factorisations = 0;
-    for (int k = 0; k < 6; ++k) {
-      const auto r = sim.step();
-      factorisations += r.newton.numeric_factorizations;
-      its.push_back(r.newton.iterations);
-    }
-    return Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), sim.mpm()->particles().x);
-  };
-  long f0 = 0, f20 = 0;
-  std::vector<int> it0, it20;
-  const auto x0 = run(0, f0, it0);
-  const auto x20 = run(20, f20, it20);
-  EXPECT_EQ(it0, it20);
-  long newton = 0;
-  for (int i : it0) newton += i;
-  EXPECT_EQ(f0, newton);
-  EXPECT_LT(f20, f0);
-  EXPECT_GE(f20, 6);  // the first solve of every step factorises
+// A spinning MPM block falling under gravity, 6 steps. With the fixed
+// forcing term, CG on the previous factor solves to 1e-10, so the Newton
+// iterates are those of a factorisation at every iteration (reuse 0), to
+// round-off. With the adaptive one (the default) the early directions are
+// inexact: the run must still end at the same positions within what eps_d
+// allows, with fewer CG iterations on the old factor.
+struct SpinRun {
+  long factorisations = 0, cg_iterations = 0;
+  std::vector<int> its;
+  Kokkos::View<double**, Kokkos::LayoutRight, Kokkos::HostSpace> x;
+};
+SpinRun spin_run(int reuse, const char* forcing) {
+  auto s = fixtures::mpm_block_setup(0.3, Vec<2>(0.5, 0.6), 0.05, 4, 0.0, 1.0, TransferScheme::APIC, 2e4);
+  s.dt = 2e-2;
+  s.gravity = {0.0, -9.81, 0.0};
+  s.newton.eps_d = 1e-9;
+  s.linear_solver.sublist("Cholmod").set("reuse iterations", reuse);
+  s.linear_solver.sublist("Cholmod").set("forcing term", std::string(forcing));
+  auto& p = s.mpm->particles;
+  for (std::size_t q = 0; q < p.v.extent(0); ++q) {  // spin about the centre: 3 rad/s
+    p.v(q, 0) = -3.0 * (p.x(q, 1) - 0.6);
+    p.v(q, 1) = 3.0 * (p.x(q, 0) - 0.5);
+  }
+  Simulation<2> sim(s, fixtures::comm());
+  SpinRun out;
+  for (int k = 0; k < 6; ++k) {
+    const auto r = sim.step();
+    out.factorisations += r.newton.numeric_factorizations;
+    out.cg_iterations += r.newton.reuse_cg_iterations;
+    out.its.push_back(r.newton.iterations);
+  }
+  const auto xd = sim.mpm()->particles().x;
+  out.x = Kokkos::View<double**, Kokkos::LayoutRight, Kokkos::HostSpace>("x", xd.extent(0), xd.extent(1));
+  Kokkos::deep_copy(out.x, xd);
+  return out;
+}
+
+double worst_difference(const SpinRun& a, const SpinRun& b) {
   double worst = 0;
-  for (std::size_t q = 0; q < x0.extent(0); ++q)
-    for (int c = 0; c < 2; ++c) worst = std::fmax(worst, std::fabs(x0(q, c) - x20(q, c)));
+  for (std::size_t q = 0; q < a.x.extent(0); ++q)
+    for (int c = 0; c < 2; ++c) worst = std::fmax(worst, std::fabs(a.x(q, c) - b.x(q, c)));
+  return worst;
+}
+
+TEST(CholmodReuse, SceneRunsTheSameTrajectoryWithFewerFactorisations) {
+  const SpinRun r0 = spin_run(0, "fixed"), r20 = spin_run(20, "fixed");
+  EXPECT_EQ(r0.its, r20.its);
+  long newton = 0;
+  for (int i : r0.its) newton += i;
+  EXPECT_EQ(r0.factorisations, newton);
+  EXPECT_LT(r20.factorisations, r0.factorisations);
+  EXPECT_GE(r20.factorisations, 6);  // the first solve of every step factorises
+  const double worst = worst_difference(r0, r20);
   EXPECT_LT(worst, 1e-10) << "m";
   std::printf("  Newton iterations %ld; numeric factorisations %ld (reuse 0) / %ld (reuse 20); max |dx| %.2e m\n",
-              newton, f0, f20, worst);
+              newton, r0.factorisations, r20.factorisations, worst);
+}
+
+TEST(CholmodReuse, TheAdaptiveForcingTermEndsAtTheSameStateWithFewerCgIterations) {
+  const SpinRun fixed = spin_run(20, "fixed"), adaptive = spin_run(20, "adaptive");
+  EXPECT_LT(adaptive.cg_iterations, fixed.cg_iterations);
+  EXPECT_LE(adaptive.factorisations, fixed.factorisations);
+  EXPECT_GE(adaptive.factorisations, 6);
+  // eps_d 1e-9 m/s over dt 2e-2 s: the last Newton step of each solve is
+  // below 2e-11 m; six steps of such differences stay far below 1e-9 m.
+  const double worst = worst_difference(fixed, adaptive);
+  EXPECT_LT(worst, 1e-9) << "m";
+  long nf = 0, na = 0;
+  for (int i : fixed.its) nf += i;
+  for (int i : adaptive.its) na += i;
+  std::printf("  fixed: %ld Newton iterations, %ld CG on the old factor, %ld factorisations; adaptive: %ld, %ld, %ld;"
+              " max |dx| %.2e m\n",
+              nf, fixed.cg_iterations, fixed.factorisations, na, adaptive.cg_iterations, adaptive.factorisations,
+              worst);
 }
 
 }  // namespace

@@ -149,7 +149,12 @@ TEST(SceneErrors, BadEnumAndSolverKeys) {
                  {"reuse iterations", "-1"});
   expect_message(error_of(scene_with("type: CG", "type: Cholmod\n    Cholmod:\n      reuse tolerance: 0.1")),
                  {"reuse tolerance", "0.1"});
+  expect_message(error_of(scene_with("type: CG", "type: CG\n    Cholmod:\n      forcing term: fixed")),
+                 {"Linear Solver/Cholmod", "CG", "type Cholmod"});
+  expect_message(error_of(scene_with("type: CG", "type: Cholmod\n    Cholmod:\n      forcing term: adaptiv")),
+                 {"forcing term", "adaptiv", "adaptive"});
   EXPECT_EQ(error_of(scene_with("type: CG", "type: Cholmod\n    Cholmod:\n      reuse iterations: 0")), "");
+  EXPECT_EQ(error_of(scene_with("type: CG", "type: Cholmod\n    Cholmod:\n      forcing term: fixed")), "");
 }
 
 TEST(SceneErrors, UnknownNodeSetAndMaterial) {
