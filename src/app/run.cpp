@@ -24,6 +24,7 @@ namespace bfemp {
 namespace {
 
 const char* kRestartKeys[] = {"Time/end time", "Output/", "Newton/", "Linear Solver/", "Contact/friction iterations",
+                              "Contact/friction pass tolerance",
                               "Contact/check iterates"};
 
 std::string join_lines(const std::vector<std::string>& v) {

@@ -23,6 +23,11 @@ struct ContactParams {
   // already (no rebuild, no new symbolic analysis inside the step).
   double graph_margin = 3.0;
   int friction_max_iterations = 20;  // outer friction loop cap per step
+  // The friction loop's passes stop Newton at this multiple of Newton/eps_d
+  // until a pass converges within it at its first iteration; the passes
+  // after that stop at eps_d (Simulation::minimize_with_friction). 1: every
+  // pass at eps_d.
+  double friction_pass_tolerance = 10.0;
   std::vector<double> mu;  // [mpm body * n_fem + fem body]; empty: frictionless
   int force_body = -1;     // FEM body whose contact force is reported (-1: all)
   bool check_iterates = false;  // debug: every Newton iterate is checked for penetration
@@ -70,6 +75,7 @@ class Contact {
   // Re-lags friction at x (see FrictionTerm); returns the pairs with friction.
   LO update_friction(ConstDofView x, ConstDofView x_ref, double s, double dt);
   int friction_max_iterations() const { return params_.friction_max_iterations; }
+  double friction_pass_tolerance() const { return params_.friction_pass_tolerance; }
 
   struct Report {
     LO pairs = 0;                   // pairs with d < dhat

@@ -274,8 +274,9 @@ typename NewtonSolver<dim>::Energy NewtonSolver<dim>::energy(const IncrementalPo
 }
 
 template <int dim>
-NewtonStats NewtonSolver<dim>::minimize(const IncrementalPotential& ip, View1 x) {
+NewtonStats NewtonSolver<dim>::minimize(const IncrementalPotential& ip, View1 x, double eps_d) {
   auto& m = *impl_;
+  const double eps = eps_d > 0 ? eps_d : m.params.eps_d;
   NewtonStats st;
   Kokkos::Timer timer;
   auto dxp = m.dx_prescribed;
@@ -418,7 +419,8 @@ NewtonStats NewtonSolver<dim>::minimize(const IncrementalPotential& ip, View1 x)
     for (const auto* t : m.dofs.terms()) a_max = std::min(a_max, t->max_step(x, dir));
     a_max = m.all_min(a_max);
     double alpha = std::min(1.0, 0.9 * a_max);
-    bool converged = p_inf / ip.dt < m.params.eps_d && pres_left == 0.0;
+    bool converged = p_inf / ip.dt < eps && pres_left == 0.0;
+    if (it == 0) st.first_p_dt = pres_left == 0.0 ? p_inf / ip.dt : std::numeric_limits<double>::infinity();
     if (converged && ls.tolerance > m.solver.tightest_tolerance()) {
       // An inexact (forcing-term) direction may underestimate |p|: decide
       // convergence on a direction solved to the full tolerance.
@@ -448,7 +450,8 @@ NewtonStats NewtonSolver<dim>::minimize(const IncrementalPotential& ip, View1 x)
             Kokkos::Max<double>(p_inf));
       }
       p_inf = m.all_max(p_inf);
-      converged = p_inf / ip.dt < m.params.eps_d;
+      converged = p_inf / ip.dt < eps;
+      if (it == 0) st.first_p_dt = p_inf / ip.dt;
       st.solve_s += timer.seconds();
       timer.reset();
       for (const auto* t : m.dofs.terms()) t->prepare_direction(x, dir);

@@ -75,6 +75,8 @@ struct NewtonStats {
   int linear_iterations = 0;
   double assembly_s = 0, solve_s = 0, line_search_s = 0;
   double min_step = 1.0;   // smallest accepted line-search step
+  double first_p_dt = 0;   // |p|_inf / dt of the first Newton direction (m/s); a step's friction loop:
+                           // that of its last pass (the loop's end test: below eps_d)
   int graph_builds = 0;            // graph rebuilds inside the solve (contact pairs outside the graph)
   int symbolic_factorizations = 0; // direct solvers: symbolic phases run
   int numeric_factorizations = 0;  // direct solvers: numeric factorisations run (failed ones too)
@@ -137,7 +139,8 @@ class NewtonSolver {
   // Minimises E from the initial guess in `x` (overwritten with the result).
   // Throws SolverError when the linear solve fails, the line search stalls or
   // the iteration cap is reached.
-  NewtonStats minimize(const IncrementalPotential& ip, Kokkos::View<double*, MemSpace> x);
+  // `eps_d` > 0 replaces NewtonParams::eps_d for this call.
+  NewtonStats minimize(const IncrementalPotential& ip, Kokkos::View<double*, MemSpace> x, double eps_d = 0.0);
 
   // Energy E(x) and its parts; exposed for tests and diagnostics.
   struct Energy { double inertia = 0, elastic = 0; double total() const { return inertia + elastic; } };

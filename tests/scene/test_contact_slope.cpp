@@ -22,6 +22,8 @@
 #include <cmath>
 #include <limits>
 #include <sstream>
+#include <string>
+#include <vector>
 
 #include "common/fem_fixtures.hpp"
 #include "io/scene.hpp"
@@ -44,15 +46,17 @@ struct SlopeRun {
   double min_distance = std::numeric_limits<double>::infinity();
   long contact_steps = 0, single_friction_solve = 0, max_friction_iters = 0, newton_iters = 0;
   long missing_block_rebuilds = 0;  // cached graph lacked a coupling (must stay 0)
+  long loop_ends_above_eps_d = 0;   // steps whose friction loop's last pass began at |p|/dt >= eps_d
   double seconds = 0;
 };
 
 // With `extra`: an additional level set (the settle-then-release support).
-SlopeRun run_slope(double mu, int steps, const LevelSet* extra = nullptr) {
+SlopeRun run_slope(double mu, int steps, const LevelSet* extra = nullptr, std::vector<std::string> sets = {}) {
   std::ostringstream set;
   set.precision(17);
   set << "Contact/friction=" << mu;
-  const Scene scene = load_scene(scene_file, {set.str()});
+  sets.push_back(set.str());
+  const Scene scene = load_scene(scene_file, sets);
   const auto t0 = std::chrono::steady_clock::now();
   auto setup = build_setup<2>(scene);
   if (extra) setup.level_sets.push_back(*extra);
@@ -77,6 +81,7 @@ SlopeRun run_slope(double mu, int steps, const LevelSet* extra = nullptr) {
       ++run.contact_steps;
       run.min_distance = std::min(run.min_distance, r.min_distance);
       if (mu > 0 && r.friction_iters < 2) ++run.single_friction_solve;
+      if (mu > 0 && !(r.newton.first_p_dt < 1e-8)) ++run.loop_ends_above_eps_d;  // the scene's eps_d
       run.max_friction_iters = std::max<long>(run.max_friction_iters, r.friction_iters);
     }
     sample();
@@ -168,4 +173,39 @@ TEST(ContactSlope, SettleAgainstASupportThenReleaseMatchesCoulomb) {
   EXPECT_LT(std::abs(x1 - x0), 1e-5) << "the support must hold the box";
   EXPECT_LT(std::abs(v1), 1e-4);
   EXPECT_LT(std::abs(a_fit - a_exact) / a_exact, 1e-4);
+}
+
+// 'Contact/friction pass tolerance': the friction loop's passes stop Newton
+// at 10 eps_d until the loop settles, the last ones at eps_d, and the loop
+// ends on the paper's test (a pass whose first direction is below eps_d).
+// Against every pass at eps_d (tolerance 1): every step's loop ends on that
+// test in both runs; the same Coulomb acceleration within the same band;
+// the box's centre of mass within what eps_d allows (each step's end
+// velocity is free within eps_d = 1e-8 m/s, so over N = 300 steps of dt =
+// 1e-3 s the positions may part by up to eps_d dt N^2 / 2 = 4.5e-7 m); and
+// fewer Newton iterations.
+TEST(ContactSlope, LooseFrictionPassesKeepTheSlideWithFewerNewtonIterations) {
+  const double mu = 0.1;
+  const SlopeRun tight = run_slope(mu, kSteps, nullptr, {"Contact/friction pass tolerance=1"});
+  const SlopeRun loose = run_slope(mu, kSteps);
+  expect_common(tight, mu);
+  expect_common(loose, mu);
+  EXPECT_EQ(tight.loop_ends_above_eps_d, 0);
+  EXPECT_EQ(loose.loop_ends_above_eps_d, 0) << "a friction loop ended on a pass at the loose tolerance";
+  const double a_exact = kG * (kSin - mu * kCos);
+  const double a_tight = probe::acceleration(tight.table, "box", 0, kT0, kT1);
+  const double a_loose = probe::acceleration(loose.table, "box", 0, kT0, kT1);
+  double worst = 0;
+  for (int k = 0; k <= 30; ++k) {
+    const double t = k * 0.01;
+    worst = std::max(worst, std::abs(probe::com(tight.table, "box", 0, t) - probe::com(loose.table, "box", 0, t)));
+  }
+  std::cout.precision(10);
+  std::cout << "slope mu = 0.1, friction pass tolerance 1 / 10: Newton iterations " << tight.newton_iters << " / "
+            << loose.newton_iters << ", a rel. error " << std::abs(a_tight - a_exact) / a_exact << " / "
+            << std::abs(a_loose - a_exact) / a_exact << ", max |com_x difference| " << worst << " m\n";
+  EXPECT_LT(std::abs(a_loose - a_exact) / a_exact, 1e-4);
+  EXPECT_LT(std::abs(a_tight - a_exact) / a_exact, 1e-4);
+  EXPECT_LT(worst, 4.5e-7) << "m";
+  EXPECT_LT(loose.newton_iters, tight.newton_iters);
 }

@@ -92,6 +92,7 @@ const std::vector<Leaf> kLeaves = {
     {"Contact/friction", "0.1", Kind::Real},
     {"Contact/Friction Pairs/disk : wall", "0.2", Kind::Real},
     {"Contact/friction iterations", "5", Kind::Int},
+    {"Contact/friction pass tolerance", "3.0", Kind::Real},
     {"Contact/force body", "wall", Kind::Text},
     {"Contact/check iterates", "false", Kind::Bool},
 };
@@ -159,6 +160,7 @@ const std::map<std::string, std::set<Mut>> kMayRun = {
     {"Contact/friction", {Mut::Zero, Mut::Missing}},
     {"Contact/Friction Pairs/disk : wall", {Mut::Zero, Mut::Missing}},
     {"Contact/friction iterations", {Mut::Missing}},
+    {"Contact/friction pass tolerance", {Mut::Missing}},  // 10
     {"Contact/force body", {Mut::Empty, Mut::Missing}},
     {"Contact/check iterates", {Mut::Missing}},
 };
