@@ -615,8 +615,11 @@ void Simulation<dim>::count_penetrations(StepReport& r) {
 // Passes whose lagged values will change again need not be minimised to
 // eps_d: while the loop has not settled, Newton stops at
 // 'Contact/friction pass tolerance' x eps_d; once a pass converges within
-// that at its first iteration (or one pass before the cap), the passes stop
-// at eps_d. The loop's end test is the paper's, at eps_d, either way.
+// that at its first iteration, and from the pass before the cap on, the
+// passes stop at eps_d, as does every pass without lagged friction pairs
+// (so the no-pairs exit below follows a pass at eps_d). The loop's end test
+// is the paper's, at eps_d, either way. Caps of 1 or 2 run every pass at
+// eps_d (the pass before the cap would be the first).
 template <int dim>
 NewtonStats Simulation<dim>::minimize_with_friction(const IncrementalPotential& ip, View1 x, View1 x_ref, double s,
                                                     int& iterations) {
@@ -632,10 +635,10 @@ NewtonStats Simulation<dim>::minimize_with_friction(const IncrementalPotential& 
   };
   LO lagged = update();  // line 5: lagged at x^n
   const double eps_d = setup_.newton.eps_d, loose_eps = contact_->friction_pass_tolerance() * eps_d;
-  bool loose = loose_eps > eps_d && lagged > 0 && cap > 1;
+  bool loose = loose_eps > eps_d && cap > 2;
   for (iterations = 1;; ++iterations) {
-    if (iterations == cap) loose = false;
-    const NewtonStats st = newton_->minimize(ip, x, loose ? loose_eps : 0.0);
+    if (iterations >= cap - 1) loose = false;
+    const NewtonStats st = newton_->minimize(ip, x, loose && lagged > 0 ? loose_eps : 0.0);
     total.iterations += st.iterations;
     total.linear_iterations += st.linear_iterations;
     total.assembly_s += st.assembly_s;

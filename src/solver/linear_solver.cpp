@@ -407,7 +407,9 @@ LinearSolveStats LinearSolver::solve(const Vector& b, Vector& x, double forcing)
                         e.what());
     }
     // One residual check per solve: a direct solver that silently returns a
-    // wrong answer is a failure.
+    // wrong answer is a failure. (Cholmod's CG on the previous factor stopped
+    // at `tolerance` by its recursive residual, which matches the true one to
+    // round-off: 2x leaves room for that and nothing more.)
     if (m.residual.is_null() || !m.residual->getMap()->isSameAs(*b.getMap()))
       m.residual = rcp(new Vector(b.getMap()));
     Vector& r = *m.residual;

@@ -20,7 +20,8 @@ struct LinearSolveStats {
   double achieved_tol = 0;   // relative residual reported by the solver
   bool refactored = false;   // a symbolic factorisation happened in this call
   bool factorised = false;   // a numeric factorisation happened in this call (direct solvers)
-  double tolerance = 0;      // relative residual the solve was asked for (0: direct)
+  double tolerance = 0;      // relative residual the solve was asked for (0: exact, a factorisation's;
+                             // Cholmod's CG on the previous factor: the tolerance it stopped at)
   double factor_s = 0;       // Cholmod: seconds in analysis + numeric factorisation
   double reuse_cg_s = 0;     // Cholmod: seconds in CG on the previous factor
   int reuse_cg_iterations = 0;  // Cholmod: CG iterations on the previous factor
@@ -48,8 +49,10 @@ class LinearSolver {
   void set_matrix(const Teuchos::RCP<const Matrix>& A);
   // Solve A x = b with the current values of A. Throws SolverError on a failed
   // factorisation or a Krylov solve that does not reach the tolerance.
-  // `forcing` > 0 (CG with 'forcing term: adaptive'): the relative residual
-  // to reach, clamped to [tolerance, 0.1]; direct solvers ignore it.
+  // `forcing` > 0 (CG, or Cholmod's CG on the previous factor, with 'forcing
+  // term: adaptive'): the relative residual to reach, clamped to
+  // [tolerance (Cholmod: reuse tolerance), 0.1]; KLU2 and Cholmod's
+  // factorisations ignore it (exact).
   LinearSolveStats solve(const Vector& b, Vector& x, double forcing = 0.0);
   // Cholmod: the next solve factorises instead of reusing the previous factor
   // (called at the start of each time step); a no-op for the others.
@@ -72,7 +75,8 @@ class LinearSolver {
   // under that SPD preconditioner). CG may converge on an indefinite matrix
   // without meeting negative curvature; the line search still demands descent.
   bool detects_indefinite() const;
-  // The tolerance of a solve with forcing 0 ('CG/tolerance'; 0 for direct).
+  // The tolerance of a solve with forcing 0 ('CG/tolerance'; Cholmod: 'reuse
+  // tolerance'; 0 for KLU2).
   double tightest_tolerance() const;
   std::string describe() const;
 

@@ -342,53 +342,65 @@ NewtonStats NewtonSolver<dim>::minimize(const IncrementalPotential& ip, View1 x,
     lifted = pres_left > 0.0;
     if (first) r0_norm = r_norm;
     const double forcing = r0_norm > 0 ? r_norm / r0_norm : 0.0;
-    LinearSolveStats ls;
     bool fallback = false;
-    double kept = 0.0;  // contact curvature kept by the fallback's projection
-    try {
-      ls = m.solver.solve(*m.b, *m.p, forcing > 0 ? forcing : 1e-300);
-    } catch (const NotPositiveDefinite&) {
-      if (project) throw;
-      // The exact Hessian is indefinite here: the projected one for this iteration.
-      st.solve_s += timer.seconds();
-      ++st.projection_fallbacks;
-      if (m.solver.kind() != LinearSolverKind::CG) ++st.numeric_factorizations;  // the one that failed
-      fallback = true;
-      project = true;
-      // Partial projections first (contact pairs keep a fraction of their
-      // negative curvature), then the full one; a failure of the last throws.
-      const std::vector<double>& keeps = m.params.fallback_keep;
-      for (std::size_t k = 0; k <= keeps.size(); ++k) {
-        const double keep = k < keeps.size() ? keeps[k] : 0.0;
-        timer.reset();
-        m.assemble(ip, x, project, keep);
-        Kokkos::fence();
-        st.assembly_s += timer.seconds();
-        timer.reset();
-        m.p->putScalar(0.0);
-        try {
-          ls = m.solver.solve(*m.b, *m.p, forcing > 0 ? forcing : 1e-300);
-          kept = keep;
-          break;
-        } catch (const SolverError&) {
-          // A partial projection may be indefinite, or so nearly singular that
-          // the solve is inaccurate: the next, stiffer one. The full
-          // projection's failure is the step's.
-          if (k == keeps.size()) throw;
-          st.solve_s += timer.seconds();
-          if (m.solver.kind() != LinearSolverKind::CG) ++st.numeric_factorizations;  // the one that failed
+    double kept = 0.0;       // contact curvature kept by the fallback's projection
+    std::size_t next_keep = 0;  // the next fallback projection to try (m.params.fallback_keep, then 0)
+    // Solves for the direction at relative residual eta (0: the solver's
+    // tightest). An exact Hessian found indefinite (a non-positive pivot, or
+    // negative curvature in CG) is replaced for this iteration by partial
+    // projections (contact pairs keep a fraction of their negative
+    // curvature), then the full one; so is a partial projection found
+    // indefinite, by the next one; a failure of the full projection throws.
+    // The loose solve may pass where the confirming tight one meets the
+    // indefiniteness: both go through here.
+    auto solve_direction = [&](double eta) {
+      const double f = eta > 0 ? eta : 1e-300;
+      try {
+        return m.solver.solve(*m.b, *m.p, f);
+      } catch (const NotPositiveDefinite&) {
+        if (project && kept == 0.0) throw;
+        st.solve_s += timer.seconds();
+        if (!project) ++st.projection_fallbacks;
+        if (m.solver.kind() != LinearSolverKind::CG) ++st.numeric_factorizations;  // the one that failed
+        fallback = true;
+        project = true;
+        const std::vector<double>& keeps = m.params.fallback_keep;
+        for (std::size_t k = next_keep; k <= keeps.size(); ++k) {
+          const double keep = k < keeps.size() ? keeps[k] : 0.0;
+          timer.reset();
+          m.assemble(ip, x, project, keep);
+          Kokkos::fence();
+          st.assembly_s += timer.seconds();
+          timer.reset();
+          m.p->putScalar(0.0);
+          try {
+            const LinearSolveStats r = m.solver.solve(*m.b, *m.p, f);
+            kept = keep;
+            next_keep = k + 1;
+            return r;
+          } catch (const SolverError&) {
+            // A partial projection may be indefinite, or so nearly singular
+            // that the solve is inaccurate: the next, stiffer one. The full
+            // projection's failure is the step's.
+            if (k == keeps.size()) throw;
+            st.solve_s += timer.seconds();
+            if (m.solver.kind() != LinearSolverKind::CG) ++st.numeric_factorizations;  // the one that failed
+          }
         }
+        throw std::logic_error("Newton: fallback projections exhausted without a throw");
       }
-      if (kept > 0) ++st.partial_projections;
-    }
-    if (!project) ++st.exact_hessian_iterations;
-    st.linear_iterations += ls.iterations;
-    if (ls.refactored) ++st.symbolic_factorizations;
-    if (ls.factorised) ++st.numeric_factorizations;
-    st.factor_s += ls.factor_s;
-    st.reuse_cg_s += ls.reuse_cg_s;
-    st.reuse_cg_iterations += ls.reuse_cg_iterations;
-    st.stale_retries += ls.stale_retries;
+    };
+    auto count_solve = [&](const LinearSolveStats& r) {
+      st.linear_iterations += r.iterations;
+      if (r.refactored) ++st.symbolic_factorizations;
+      if (r.factorised) ++st.numeric_factorizations;
+      st.factor_s += r.factor_s;
+      st.reuse_cg_s += r.reuse_cg_s;
+      st.reuse_cg_iterations += r.reuse_cg_iterations;
+      st.stale_retries += r.stale_retries;
+    };
+    const LinearSolveStats ls = solve_direction(forcing);
+    count_solve(ls);
     m.dofs.to_local(*m.p, dir);
     st.solve_s += timer.seconds();
 
@@ -426,13 +438,7 @@ NewtonStats NewtonSolver<dim>::minimize(const IncrementalPotential& ip, View1 x,
       // convergence on a direction solved to the full tolerance.
       timer.reset();
       m.p->putScalar(0.0);
-      const LinearSolveStats tight = m.solver.solve(*m.b, *m.p, 0.0);
-      st.linear_iterations += tight.iterations;
-      if (tight.factorised) ++st.numeric_factorizations;
-      st.factor_s += tight.factor_s;
-      st.reuse_cg_s += tight.reuse_cg_s;
-      st.reuse_cg_iterations += tight.reuse_cg_iterations;
-      st.stale_retries += tight.stale_retries;
+      count_solve(solve_direction(0.0));
       m.dofs.to_local(*m.p, dir);
       p_inf = 0;
       Kokkos::parallel_reduce(
@@ -460,6 +466,8 @@ NewtonStats NewtonSolver<dim>::minimize(const IncrementalPotential& ip, View1 x,
       a_max = m.all_min(a_max);
       alpha = std::min(1.0, 0.9 * a_max);
     }
+    if (!project) ++st.exact_hessian_iterations;
+    if (kept > 0) ++st.partial_projections;
     // Armijo-type backtracking on E while the prescribed DOFs are at their
     // targets; while they still move, E may rise and the filtered step is taken.
     bool wolfe_ended = false;  // this iteration's step from the Wolfe bisection (log)
@@ -515,7 +523,7 @@ NewtonStats NewtonSolver<dim>::minimize(const IncrementalPotential& ip, View1 x,
                 break;
               }
               (dc < 0 ? a : b) = c;
-              if ((b - a) * p_inf < 1e-3 * m.params.eps_d * ip.dt) break;  // below the stall test's resolution
+              if ((b - a) * p_inf < 1e-3 * eps * ip.dt) break;  // below the stall test's resolution
             }
           }
           if (found > 0) {
@@ -533,10 +541,10 @@ NewtonStats NewtonSolver<dim>::minimize(const IncrementalPotential& ip, View1 x,
         // the (filtered) Newton step is taken.
         if (alpha * std::abs(gp) < 1e-11 * scale) break;
         alpha *= 0.5;
-        if (alpha * p_inf < 1e-3 * m.params.eps_d * ip.dt) {
+        if (alpha * p_inf < 1e-3 * eps * ip.dt) {
           std::ostringstream msg;
           msg << "line search stalled at Newton iteration " << it + 1 << " (step " << alpha
-              << ", |p|_inf/dt = " << p_inf / ip.dt << " m/s, eps_d = " << m.params.eps_d << ")";
+              << ", |p|_inf/dt = " << p_inf / ip.dt << " m/s, eps_d = " << eps << ")";
           throw NewtonStalled(msg.str());
         }
       }

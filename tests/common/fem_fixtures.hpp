@@ -58,4 +58,24 @@ double mass_mean(const XView& x, const MView& node_mass, int c) {
   return sx / sm;
 }
 
+using HostPositions = Kokkos::View<double**, Kokkos::LayoutRight, Kokkos::HostSpace>;
+
+// The MPM particles' positions, copied to the host (a copy: on an OpenMP
+// build a host mirror of the device View would alias it and move on).
+template <int dim>
+HostPositions particle_positions(const Simulation<dim>& sim) {
+  const auto& px = sim.mpm()->particles().x;
+  HostPositions x("x", px.extent(0), px.extent(1));
+  Kokkos::deep_copy(x, px);
+  return x;
+}
+
+// max |a - b| over every entry (same extents).
+inline double max_abs_difference(const HostPositions& a, const HostPositions& b) {
+  double worst = 0;
+  for (std::size_t q = 0; q < a.extent(0); ++q)
+    for (std::size_t c = 0; c < a.extent(1); ++c) worst = std::fmax(worst, std::fabs(a(q, c) - b(q, c)));
+  return worst;
+}
+
 }  // namespace bfemp::fixtures

@@ -24,7 +24,7 @@ namespace {
 
 struct TwistRun {
   long newton = 0, fallbacks = 0, partial = 0;
-  Kokkos::View<double**, Kokkos::LayoutRight, Kokkos::HostSpace> x;
+  fixtures::HostPositions x;
 };
 
 TwistRun run(const std::string& keep) {
@@ -40,9 +40,7 @@ TwistRun run(const std::string& keep) {
     out.fallbacks += r.newton.projection_fallbacks;
     out.partial += r.newton.partial_projections;
   }
-  const auto& px = sim.mpm()->particles().x;
-  out.x = decltype(out.x)("x", px.extent(0), 3);
-  Kokkos::deep_copy(out.x, px);
+  out.x = fixtures::particle_positions(sim);
   return out;
 }
 
@@ -55,9 +53,7 @@ TEST(FallbackKeep, A7TwistSameStateInFewerNewtonIterations) {
   EXPECT_GT(kept.partial, 0);
   EXPECT_LT(kept.newton, full.newton);
   ASSERT_EQ(full.x.extent(0), kept.x.extent(0));
-  double worst = 0;
-  for (std::size_t q = 0; q < full.x.extent(0); ++q)
-    for (int c = 0; c < 3; ++c) worst = std::max(worst, std::abs(full.x(q, c) - kept.x(q, c)));
+  const double worst = fixtures::max_abs_difference(full.x, kept.x);
   EXPECT_LT(worst, 1e-4) << "30 steps of Newton tolerance 1e-5 m each";
   std::printf("  Newton its: projection at once %ld (%ld projected), keep [0.7, 0.3] %ld (%ld fallbacks, %ld partial); "
               "largest particle position difference %.3g m\n",

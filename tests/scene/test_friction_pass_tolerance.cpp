@@ -31,7 +31,7 @@ constexpr double kEpsD = 1e-3, kDt = 1e-2;
 
 struct TwistRun {
   long newton = 0, contact_steps = 0, ends_above_eps_d = 0, multi_pass_steps = 0;
-  Kokkos::View<double**, Kokkos::LayoutRight, Kokkos::HostSpace> x;
+  fixtures::HostPositions x;
 };
 
 TwistRun run(const std::string& tolerance) {
@@ -52,9 +52,7 @@ TwistRun run(const std::string& tolerance) {
       }
     }
   }
-  const auto& px = sim.mpm()->particles().x;
-  out.x = decltype(out.x)("x", px.extent(0), 3);
-  Kokkos::deep_copy(out.x, px);
+  out.x = fixtures::particle_positions(sim);
   return out;
 }
 
@@ -68,9 +66,7 @@ TEST(FrictionPassTolerance, A7TwistEndsEveryLoopAtEpsDInFewerNewtonIterations) {
   EXPECT_EQ(tight.contact_steps, loose.contact_steps);
   EXPECT_LT(loose.newton, tight.newton);
   ASSERT_EQ(tight.x.extent(0), loose.x.extent(0));
-  double worst = 0;
-  for (std::size_t q = 0; q < tight.x.extent(0); ++q)
-    for (int c = 0; c < 3; ++c) worst = std::max(worst, std::abs(tight.x(q, c) - loose.x(q, c)));
+  const double worst = fixtures::max_abs_difference(tight.x, loose.x);
   const double bound = kEpsD * kDt * kSteps * kSteps / 2;
   std::printf("  Newton iterations %ld (tolerance 1) / %ld (10); %ld contact steps, %ld with several passes; "
               "max particle position difference %.2e m (bound %.2e)\n",
