@@ -523,7 +523,7 @@ NewtonStats NewtonSolver<dim>::minimize(const IncrementalPotential& ip, View1 x,
                 break;
               }
               (dc < 0 ? a : b) = c;
-              if ((b - a) * p_inf < 1e-3 * eps * ip.dt) break;  // below the stall test's resolution
+              if ((b - a) * p_inf < 1e-3 * m.params.eps_d * ip.dt) break;  // below the stall test's resolution
             }
           }
           if (found > 0) {
@@ -541,10 +541,12 @@ NewtonStats NewtonSolver<dim>::minimize(const IncrementalPotential& ip, View1 x,
         // the (filtered) Newton step is taken.
         if (alpha * std::abs(gp) < 1e-11 * scale) break;
         alpha *= 0.5;
-        if (alpha * p_inf < 1e-3 * eps * ip.dt) {
+        // (The stall test is the scene's eps_d, also in a loose friction pass:
+        // it judges the energy's resolution, not convergence.)
+        if (alpha * p_inf < 1e-3 * m.params.eps_d * ip.dt) {
           std::ostringstream msg;
           msg << "line search stalled at Newton iteration " << it + 1 << " (step " << alpha
-              << ", |p|_inf/dt = " << p_inf / ip.dt << " m/s, eps_d = " << eps << ")";
+              << ", |p|_inf/dt = " << p_inf / ip.dt << " m/s, eps_d = " << m.params.eps_d << ")";
           throw NewtonStalled(msg.str());
         }
       }
