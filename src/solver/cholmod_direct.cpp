@@ -115,22 +115,42 @@ static bool cg_on_old_factor(CholmodDirect::Reuse reuse, cholmod_common& c, chol
                              cholmod_dense*& Y, cholmod_dense*& E, const Matrix& A, const Vector& b,
                              Kokkos::View<double*, MemSpace> x, Kokkos::View<double*, MemSpace> r,
                              Kokkos::View<double*, MemSpace> z, Kokkos::View<double*, MemSpace> p,
-                             Kokkos::View<double*, MemSpace> q, int& its) {
+                             Kokkos::View<double*, MemSpace> q, const Vector* x0, int& its) {
   const auto lcl = A.getLocalMatrixDevice();
   const auto rows = lcl.graph.row_map;
   const auto cols = lcl.graph.entries;
   const auto vals = lcl.values;
   const std::size_t n = x.extent(0);
   const auto bv = b.getLocalViewDevice(Tpetra::Access::ReadOnly);
-  Kokkos::parallel_for(
-      "cholmod_cg_init", Range(0, n), KOKKOS_LAMBDA(const std::size_t k) {
-        x(k) = 0.0;
-        r(k) = bv(k, 0);
-      });
-  const double bn = std::sqrt(dot(r, r));
+  double bn = 0;
+  Kokkos::parallel_reduce(
+      "cholmod_cg_bnorm", Range(0, n), KOKKOS_LAMBDA(const std::size_t k, double& acc) { acc += bv(k, 0) * bv(k, 0); },
+      bn);
+  bn = std::sqrt(bn);
   its = 0;
-  if (bn == 0.0) return true;
+  if (bn == 0.0) {
+    Kokkos::deep_copy(x, 0.0);
+    return true;
+  }
+  if (x0) {  // r = b - A x0: CG goes on from the caller's iterate
+    const auto xv = x0->getLocalViewDevice(Tpetra::Access::ReadOnly);
+    Kokkos::parallel_for(
+        "cholmod_cg_init_from", Range(0, n), KOKKOS_LAMBDA(const std::size_t i) {
+          double acc = 0;
+          for (auto k = rows(i); k < rows(i + 1); ++k) acc += vals(k) * xv(cols(k), 0);
+          x(i) = xv(i, 0);
+          r(i) = bv(i, 0) - acc;
+        });
+  } else {
+    Kokkos::parallel_for(
+        "cholmod_cg_init", Range(0, n), KOKKOS_LAMBDA(const std::size_t k) {
+          x(k) = 0.0;
+          r(k) = bv(k, 0);
+        });
+  }
+  const double r0n = x0 ? std::sqrt(dot(r, r)) : bn;  // the rate test measures from here
   const double stop = reuse.tolerance * bn;
+  if (r0n <= stop) return true;
   auto precondition = [&]() {  // z = (L L^T)^-1 r
     cholmod_dense R = dense_column_view(r.data(), n);
     {
@@ -177,7 +197,7 @@ static bool cg_on_old_factor(CholmodDirect::Reuse reuse, cholmod_common& c, chol
     if (rn <= stop) return true;
     // Too slow to arrive within the cap at the mean rate so far: factorise.
     if (its >= 4 && its < reuse.max_iterations) {
-      const double rate = std::pow(rn / bn, 1.0 / its);
+      const double rate = std::pow(rn / r0n, 1.0 / its);
       if (rate >= 1.0 || its + std::log(stop / rn) / std::log(rate) > reuse.max_iterations) return false;
     }
     if (its == reuse.max_iterations) break;
@@ -191,7 +211,7 @@ static bool cg_on_old_factor(CholmodDirect::Reuse reuse, cholmod_common& c, chol
   return false;
 }
 
-CholmodDirect::Result CholmodDirect::solve(const Vector& b, Vector& x, double tolerance) {
+CholmodDirect::Result CholmodDirect::solve(const Vector& b, Vector& x, double tolerance, bool from_x) {
   auto& m = *impl_;
   if (m.A.is_null()) throw std::logic_error("CholmodDirect::solve before set_matrix");
   Result res;
@@ -202,7 +222,7 @@ CholmodDirect::Result CholmodDirect::solve(const Vector& b, Vector& x, double to
     r.tolerance = std::max(r.tolerance, tolerance);
     res.cg_budget = m.budget;
     const bool ok = cg_on_old_factor(r, m.c, m.L, m.X, m.Y, m.E, *m.A, b, m.cg_x, m.cg_r, m.cg_z, m.cg_p,
-                                     m.cg_q, res.cg_iterations);
+                                     m.cg_q, from_x ? &x : nullptr, res.cg_iterations);
     res.cg_s = cg_timer.seconds();
     if (ok) {
       res.tolerance = r.tolerance;

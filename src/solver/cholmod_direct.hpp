@@ -92,7 +92,10 @@ class CholmodDirect {
   // reuse allows it, else a numeric factorisation and the triangular solves.
   // `tolerance` > the reuse tolerance: CG on the previous factor may stop
   // there (an inexact Newton direction); the factorisation's solve is exact.
-  Result solve(const Vector& b, Vector& x, double tolerance = 0.0);
+  // `from_x`: CG on the previous factor starts from x (an earlier, looser
+  // solution of this system: the Newton step's confirming solve) instead of
+  // 0; the stop stays relative to |b|. Without it x is output only.
+  Result solve(const Vector& b, Vector& x, double tolerance = 0.0, bool from_x = false);
   // The next solve factorises (a new time step: runs and their restarts then
   // take the same path).
   void forget_factor();

@@ -369,7 +369,7 @@ void LinearSolver::set_matrix(const RCP<const Matrix>& A) {
   m.symbolic_done = false;
 }
 
-LinearSolveStats LinearSolver::solve(const Vector& b, Vector& x, double forcing) {
+LinearSolveStats LinearSolver::solve(const Vector& b, Vector& x, double forcing, bool from_x) {
   auto& m = *impl_;
   if (m.A.is_null()) throw std::logic_error("LinearSolver::solve before set_matrix");
   LinearSolveStats stats;
@@ -380,7 +380,7 @@ LinearSolveStats LinearSolver::solve(const Vector& b, Vector& x, double forcing)
         // Newton forcing term (floor: the reuse tolerance); a factorisation's
         // solve is exact either way.
         const double ctol = m.reuse.adaptive && forcing > 0 ? std::min(0.1, forcing) : 0.0;
-        const CholmodDirect::Result r = m.cholmod->solve(b, x, ctol);
+        const CholmodDirect::Result r = m.cholmod->solve(b, x, ctol, from_x);
         stats.tolerance = r.tolerance;
         stats.refactored = r.analysed;
         stats.factorised = r.factorised;
@@ -456,6 +456,18 @@ LinearSolveStats LinearSolver::solve(const Vector& b, Vector& x, double forcing)
   }
   const double tol = m.adaptive && forcing > 0 ? std::max(m.cg_tol, std::min(0.1, forcing)) : m.cg_tol;
   stats.tolerance = tol;
+  // CG from x (from_x), else from 0. The block factor's rate below counts
+  // decades from the start's relative residual.
+  double start_rel = 1.0;
+  if (!from_x) {
+    x.putScalar(0.0);
+  } else if (!m.block.is_null() && m.block_reuse) {
+    if (m.residual.is_null() || !m.residual->getMap()->isSameAs(*b.getMap())) m.residual = rcp(new Vector(b.getMap()));
+    m.A->apply(x, *m.residual);
+    m.residual->update(1.0, b, -1.0);
+    const double bn = b.norm2();
+    start_rel = bn > 0 ? std::min(1.0, m.residual->norm2() / bn) : 1.0;
+  }
   auto bp = Teuchos::parameterList();
   bp->set("Convergence Tolerance", tol);
   bp->set("Maximum Iterations", m.cg_max_iters);
@@ -484,7 +496,7 @@ LinearSolveStats LinearSolver::solve(const Vector& b, Vector& x, double forcing)
   stats.achieved_tol = cg.achievedTol();
   if (!m.block.is_null() && m.block_reuse && ret == Belos::Converged && stats.iterations > 0 && !m.block_retrying) {
     // CG iterations per decade of residual reduction, fresh factor against stale
-    const double decades = std::max(1.0, -std::log10(std::max(stats.achieved_tol, 1e-300)));
+    const double decades = std::max(1.0, std::log10(start_rel / std::max(stats.achieved_tol, 1e-300)));
     const double rate = stats.iterations / decades;
     if (stats.factorised) m.block_fresh_rate = rate;
     else m.block_excess_its += std::max(0.0, (rate - m.block_fresh_rate) * decades);
@@ -497,7 +509,7 @@ LinearSolveStats LinearSolver::solve(const Vector& b, Vector& x, double forcing)
     m.block_retrying = true;
     LinearSolveStats again;
     try {
-      again = solve(b, x, forcing);
+      again = solve(b, x, forcing, true);
     } catch (...) {
       m.block_retrying = false;
       throw;

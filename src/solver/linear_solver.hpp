@@ -53,7 +53,11 @@ class LinearSolver {
   // term: adaptive'): the relative residual to reach, clamped to
   // [tolerance (Cholmod: reuse tolerance), 0.1]; KLU2 and Cholmod's
   // factorisations ignore it (exact).
-  LinearSolveStats solve(const Vector& b, Vector& x, double forcing = 0.0);
+  // `from_x`: x holds a starting iterate, an earlier looser solution of this
+  // system (Newton's confirming solve goes on from its inexact direction):
+  // CG and Cholmod's CG on the previous factor start there; the tolerance
+  // stays relative to |b|. Without it x is output only (CG starts from 0).
+  LinearSolveStats solve(const Vector& b, Vector& x, double forcing = 0.0, bool from_x = false);
   // Cholmod: the next solve factorises instead of reusing the previous factor
   // (called at the start of each time step); a no-op for the others.
   void forget_factor();

@@ -353,10 +353,12 @@ NewtonStats NewtonSolver<dim>::minimize(const IncrementalPotential& ip, View1 x,
     // indefinite, by the next one; a failure of the full projection throws.
     // The loose solve may pass where the confirming tight one meets the
     // indefiniteness: both go through here.
-    auto solve_direction = [&](double eta) {
+    // `from_p`: the solve goes on from m.p (the confirming solve from the
+    // loose direction); the fallback's solves of other matrices start at 0.
+    auto solve_direction = [&](double eta, bool from_p) {
       const double f = eta > 0 ? eta : 1e-300;
       try {
-        return m.solver.solve(*m.b, *m.p, f);
+        return m.solver.solve(*m.b, *m.p, f, from_p);
       } catch (const NotPositiveDefinite&) {
         if (project && kept == 0.0) throw;
         st.solve_s += timer.seconds();
@@ -399,7 +401,7 @@ NewtonStats NewtonSolver<dim>::minimize(const IncrementalPotential& ip, View1 x,
       st.reuse_cg_iterations += r.reuse_cg_iterations;
       st.stale_retries += r.stale_retries;
     };
-    const LinearSolveStats ls = solve_direction(forcing);
+    const LinearSolveStats ls = solve_direction(forcing, false);
     count_solve(ls);
     m.dofs.to_local(*m.p, dir);
     st.solve_s += timer.seconds();
@@ -435,10 +437,10 @@ NewtonStats NewtonSolver<dim>::minimize(const IncrementalPotential& ip, View1 x,
     if (it == 0) st.first_p_dt = pres_left == 0.0 ? p_inf / ip.dt : std::numeric_limits<double>::infinity();
     if (converged && ls.tolerance > m.solver.tightest_tolerance()) {
       // An inexact (forcing-term) direction may underestimate |p|: decide
-      // convergence on a direction solved to the full tolerance.
+      // convergence on a direction solved to the full tolerance, going on
+      // from the loose one (m.p still holds it: the same matrix and b).
       timer.reset();
-      m.p->putScalar(0.0);
-      count_solve(solve_direction(0.0));
+      count_solve(solve_direction(0.0, true));
       m.dofs.to_local(*m.p, dir);
       p_inf = 0;
       Kokkos::parallel_reduce(

@@ -145,6 +145,52 @@ TEST(CholmodReuse, ALooserToleranceStopsCgEarlierAndIsReported) {
               tight.cg_iterations, loose.cg_iterations, rl);
 }
 
+// Newton's confirming solve: CG on the previous factor goes on from the loose
+// solution (from_x) and reaches the tight tolerance, relative to |b| as a
+// cold solve, in fewer iterations than a cold solve; the answers agree to
+// that tolerance. A starting x that already meets the tolerance costs no
+// iteration and is returned as it is.
+TEST(CholmodReuse, TheConfirmingSolveGoesOnFromTheLooseSolution) {
+  Fixture f;
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> u(-0.3, 0.3);
+  auto s2 = f.shift;
+  for (double& s : s2) s *= 1.0 + u(rng);
+  CholmodDirect solver(CholmodReuse{20, 1e-10});
+  solver.set_matrix(f.A);
+  ASSERT_TRUE(solver.solve(f.b, f.x).factorised);
+  copy_values(*laplacian(s2), *f.A);
+  Vector x(f.A->getRowMap());
+  const auto loose = solver.solve(f.b, x, 1e-3);
+  ASSERT_FALSE(loose.factorised);
+  const double rl = relative_residual(*f.A, x, f.b);
+  ASSERT_LT(rl, 1e-3);
+  ASSERT_GT(rl, 1e-10);
+  const auto warm = solver.solve(f.b, x, 0.0, /*from_x=*/true);
+  Vector xc(f.A->getRowMap());
+  xc.putScalar(123.0);  // ignored without from_x
+  const auto cold = solver.solve(f.b, xc, 0.0);
+  ASSERT_FALSE(warm.factorised);
+  ASSERT_FALSE(cold.factorised);
+  EXPECT_EQ(warm.tolerance, 1e-10);
+  EXPECT_LT(relative_residual(*f.A, x, f.b), 1e-10);
+  EXPECT_LT(relative_residual(*f.A, xc, f.b), 1e-10);
+  EXPECT_LT(warm.cg_iterations, cold.cg_iterations);
+  EXPECT_GE(warm.cg_iterations, 1);
+  Vector d(f.A->getRowMap());
+  d.update(1.0, x, -1.0, xc, 0.0);
+  EXPECT_LT(d.norm2() / xc.norm2(), 1e-8);
+  // Already converged: nothing to do, x untouched.
+  Vector keep(x, Teuchos::Copy);
+  const auto none = solver.solve(f.b, x, 0.0, true);
+  EXPECT_FALSE(none.factorised);
+  EXPECT_EQ(none.cg_iterations, 0);
+  d.update(1.0, x, -1.0, keep, 0.0);
+  EXPECT_EQ(d.normInf(), 0.0);
+  std::printf("  confirming solve to 1e-10: %d CG iterations from the 1e-3 solution, %d from 0\n",
+              warm.cg_iterations, cold.cg_iterations);
+}
+
 TEST(CholmodReuse, FarValuesAreFactorisedAnew) {
   Fixture f;
   CholmodDirect solver(CholmodReuse{20, 1e-10});
