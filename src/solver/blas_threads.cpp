@@ -1,7 +1,12 @@
 #include "solver/blas_threads.hpp"
 
 #include <dlfcn.h>
+#include <omp.h>
+#include <pthread.h>
 
+#include <Kokkos_Core.hpp>
+
+#include <algorithm>
 #include <cstdlib>
 
 namespace bfemp {
@@ -17,6 +22,58 @@ GetThreads get_fn() { return reinterpret_cast<GetThreads>(dlsym(RTLD_DEFAULT, "o
 int blas_threads() {
   const GetThreads get = get_fn();
   return get ? get() : 0;
+}
+
+namespace {
+bool user_set_threads() {
+  for (const char* var : {"OPENBLAS_NUM_THREADS", "GOTO_NUM_THREADS"}) {
+    const char* user = std::getenv(var);
+    if (user && *user) return true;
+  }
+  return false;
+}
+
+// Kokkos' host team size (its OpenMP pool; the caller's own
+// omp_get_max_threads() is 1 outside Kokkos' regions).
+int team_size() { return Kokkos::DefaultHostExecutionSpace::concurrency(); }
+
+// The union of the CPU masks of Kokkos' OpenMP team's threads (the cores it
+// runs on), asked once.
+const cpu_set_t& team_cores() {
+  static const cpu_set_t cores = [] {
+    cpu_set_t all;
+    CPU_ZERO(&all);
+#pragma omp parallel num_threads(team_size())
+    {
+      cpu_set_t mine;
+      CPU_ZERO(&mine);
+      if (pthread_getaffinity_np(pthread_self(), sizeof(mine), &mine) == 0) {
+#pragma omp critical(bfemp_team_cores)
+        CPU_OR(&all, &all, &mine);
+      }
+    }
+    return all;
+  }();
+  return cores;
+}
+}  // namespace
+
+BlasTeamScope::BlasTeamScope(double flops) {
+  if (!(flops >= kTeamFlops) || omp_in_parallel() || team_size() < 2 || user_set_threads()) return;
+  const SetThreads set = set_fn();
+  if (!set || !get_fn()) return;
+  const cpu_set_t& team = team_cores();
+  const int n = std::min(team_size(), CPU_COUNT(&team));
+  if (n < 2 || pthread_getaffinity_np(pthread_self(), sizeof(saved_), &saved_) != 0) return;
+  if (pthread_setaffinity_np(pthread_self(), sizeof(team), &team) != 0) return;
+  set(n);
+  threads_ = n;
+}
+
+BlasTeamScope::~BlasTeamScope() {
+  if (threads_ == 0) return;
+  set_fn()(1);
+  pthread_setaffinity_np(pthread_self(), sizeof(saved_), &saved_);
 }
 
 std::string configure_blas_threads() {

@@ -10,6 +10,7 @@
 #include <utility>
 #include <vector>
 
+#include "solver/blas_threads.hpp"
 #include "solver/cholmod_common.hpp"
 #include "solver/cholmod_views.hpp"
 #include "solver/solver_error.hpp"
@@ -48,6 +49,7 @@ struct CholmodDirect::Impl {
   bool spare_wanted = false;  // a non-positive pivot was met in this step: keep L while refactorising
   Reuse reuse;
   int budget = 0;  // CG iterations allowed on the previous factor (reuse.max_iterations, or by cost)
+  double flops = 0;  // of one numeric factorisation (the analysis' Common->fl)
   using V = Kokkos::View<double*, MemSpace>;
   V cg_x, cg_r, cg_z, cg_p, cg_q;  // CG work, sized once per graph
 
@@ -245,6 +247,7 @@ CholmodDirect::Result CholmodDirect::solve(const Vector& b, Vector& x, double to
     if (!m.L || m.c.status < CHOLMOD_OK)
       throw SolverError("Cholmod analysis failed: " + status_name(m.c.status));
     m.analysed = true;
+    m.flops = m.c.fl;
     analysed_now = true;
     m.budget = m.reuse.max_iterations;
     if (m.reuse.by_cost && m.reuse.max_iterations > 0 && m.L->is_super) {  // (a simplicial factor: no BLAS 3)
@@ -270,6 +273,7 @@ CholmodDirect::Result CholmodDirect::solve(const Vector& b, Vector& x, double to
   if (!keep) m.factor_ok = false;
   bool factorised;
   {
+    BlasTeamScope team(m.flops);  // a large factorisation: the BLAS on the team's cores
     CholmodSerialScope serial;
     factorised = cholmod_l_factorize(&S, target, &m.c);
   }
