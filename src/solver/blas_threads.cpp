@@ -38,23 +38,35 @@ bool user_set_threads() {
 int team_size() { return Kokkos::DefaultHostExecutionSpace::concurrency(); }
 
 // The union of the CPU masks of Kokkos' OpenMP team's threads (the cores it
-// runs on), asked once.
-const cpu_set_t& team_cores() {
-  static const cpu_set_t cores = [] {
-    cpu_set_t all;
-    CPU_ZERO(&all);
+// runs on). Kept once the whole team answered (a region that ran on fewer
+// threads, e.g. inside CholmodSerialScope, is asked again next time).
+bool team_cores(cpu_set_t& out) {
+  static cpu_set_t cores;
+  static bool known = false;
+  if (known) {
+    out = cores;
+    return true;
+  }
+  cpu_set_t all;
+  CPU_ZERO(&all);
+  int answered = 0;
 #pragma omp parallel num_threads(team_size())
-    {
-      cpu_set_t mine;
-      CPU_ZERO(&mine);
-      if (pthread_getaffinity_np(pthread_self(), sizeof(mine), &mine) == 0) {
+  {
+    cpu_set_t mine;
+    CPU_ZERO(&mine);
+    if (pthread_getaffinity_np(pthread_self(), sizeof(mine), &mine) == 0) {
 #pragma omp critical(bfemp_team_cores)
+      {
         CPU_OR(&all, &all, &mine);
+        ++answered;
       }
     }
-    return all;
-  }();
-  return cores;
+  }
+  if (answered != team_size()) return false;
+  cores = all;
+  known = true;
+  out = cores;
+  return true;
 }
 }  // namespace
 
@@ -62,17 +74,19 @@ BlasTeamScope::BlasTeamScope(double flops) {
   if (!(flops >= kTeamFlops) || omp_in_parallel() || team_size() < 2 || user_set_threads()) return;
   const SetThreads set = set_fn();
   if (!set || !get_fn()) return;
-  const cpu_set_t& team = team_cores();
+  cpu_set_t team;
+  if (!team_cores(team)) return;
   const int n = std::min(team_size(), CPU_COUNT(&team));
   if (n < 2 || pthread_getaffinity_np(pthread_self(), sizeof(saved_), &saved_) != 0) return;
   if (pthread_setaffinity_np(pthread_self(), sizeof(team), &team) != 0) return;
+  previous_ = blas_threads();
   set(n);
   threads_ = n;
 }
 
 BlasTeamScope::~BlasTeamScope() {
   if (threads_ == 0) return;
-  set_fn()(1);
+  set_fn()(previous_);
   pthread_setaffinity_np(pthread_self(), sizeof(saved_), &saved_);
 }
 

@@ -26,19 +26,21 @@
 // looked up at run time, nothing links against OpenBLAS.
 //
 // Large factorisations (BlasTeamScope): where one numeric factorisation is
-// large (kTeamFlops and more: the 3D twist at the paper's size, 5.4e10 flops,
-// against 6.7e7 for the 2D rings), its dense BLAS 3 work is worth the second
+// large (kTeamFlops and more: the 3D twist at the paper's size, 5.4e10 flops
+// at first contact and 6.3e10 at t = 1.0, against 6.7e7 for the 2D rings), its dense BLAS 3 work is worth the second
 // core, which Kokkos' team leaves idle while CHOLMOD runs on the calling
 // thread. For the scope's lifetime OpenBLAS gets as many threads as Kokkos'
 // OpenMP team has cores, and the calling thread's CPU mask is widened to the
 // cores of the team's threads, so that a worker OpenBLAS creates inside it
-// (it creates them lazily, with its creator's mask) may run on them;
-// restored on exit. Measured on the paper twist (1 rank, 2 threads,
-// `OMP_PROC_BIND=spread`, 2 twisting steps from t = 1.0): analysis +
-// factorisation 14.1 s -> 9.3 s for the same 16 factorisations; without the
-// widened mask the worker shares core 0 with the caller and nothing is
+// (it creates them lazily, with its creator's mask) may run on them; the
+// count and the mask are restored on exit. Measured on the paper twist at
+// t = 1.0 (6.3e10 flops per factorisation; 1 rank, 2 threads,
+// `OMP_PROC_BIND=spread`, 5 twisting steps, 16 factorisations, two
+// alternations): analysis + factorisation 31.8-34.4 s -> 22.4-23.9 s; without
+// the widened mask the worker shared core 0 with the caller and nothing was
 // gained. The triangular solves (CG on the previous factor, BLAS 2 bound by
-// memory) stay on one thread: two made them slower (19.3 -> 22-24 s).
+// memory) stay on one thread: two made them slower (19.3 -> 22-24 s in two
+// twisting steps).
 // A no-op when OPENBLAS_NUM_THREADS or GOTO_NUM_THREADS is set (the user's
 // choice stands), when the BLAS is not OpenBLAS, when the team has one core,
 // or inside a parallel region. Open it on the host thread, outside any
@@ -70,6 +72,7 @@ class BlasTeamScope {
 
  private:
   int threads_ = 0;
+  int previous_ = 1;  // OpenBLAS' count before the scope, restored on exit
   cpu_set_t saved_{};
 };
 

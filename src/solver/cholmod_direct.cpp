@@ -150,7 +150,15 @@ static bool cg_on_old_factor(CholmodDirect::Reuse reuse, cholmod_common& c, chol
           r(k) = bv(k, 0);
         });
   }
-  const double r0n = x0 ? std::sqrt(dot(r, r)) : bn;  // the rate test measures from here
+  double r0n = x0 ? std::sqrt(dot(r, r)) : bn;  // the rate test measures from here
+  if (x0 && !(r0n <= bn)) {  // a start worse than 0: from 0
+    Kokkos::parallel_for(
+        "cholmod_cg_init", Range(0, n), KOKKOS_LAMBDA(const std::size_t k) {
+          x(k) = 0.0;
+          r(k) = bv(k, 0);
+        });
+    r0n = bn;
+  }
   const double stop = reuse.tolerance * bn;
   if (r0n <= stop) return true;
   auto precondition = [&]() {  // z = (L L^T)^-1 r

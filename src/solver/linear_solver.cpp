@@ -456,17 +456,20 @@ LinearSolveStats LinearSolver::solve(const Vector& b, Vector& x, double forcing,
   }
   const double tol = m.adaptive && forcing > 0 ? std::max(m.cg_tol, std::min(0.1, forcing)) : m.cg_tol;
   stats.tolerance = tol;
-  // CG from x (from_x), else from 0. The block factor's rate below counts
-  // decades from the start's relative residual.
+  // CG from x (from_x), else from 0; a start worse than 0 (|b - A x| > |b|)
+  // from 0. The block factor's rate below counts decades from the start's
+  // relative residual.
   double start_rel = 1.0;
-  if (!from_x) {
-    x.putScalar(0.0);
-  } else if (!m.block.is_null() && m.block_reuse) {
+  if (from_x) {
     if (m.residual.is_null() || !m.residual->getMap()->isSameAs(*b.getMap())) m.residual = rcp(new Vector(b.getMap()));
     m.A->apply(x, *m.residual);
     m.residual->update(1.0, b, -1.0);
     const double bn = b.norm2();
-    start_rel = bn > 0 ? std::min(1.0, m.residual->norm2() / bn) : 1.0;
+    start_rel = bn > 0 ? m.residual->norm2() / bn : 1.0;
+  }
+  if (!(start_rel < 1.0)) {
+    x.putScalar(0.0);
+    start_rel = 1.0;
   }
   auto bp = Teuchos::parameterList();
   bp->set("Convergence Tolerance", tol);

@@ -444,3 +444,51 @@ TEST(LinearSolverMpi, BlockCholmodCgProvesIndefinitenessWhenEveryBlockIsDefinite
   r.update(1.0, b, -1.0);
   EXPECT_LT(r.norm2() / b.norm2(), 1e-10);
 }
+
+namespace {
+double relative_residual(const Matrix& A, const Vector& x, const Vector& b) {
+  Vector r(b.getMap());
+  A.apply(x, r);
+  r.update(1.0, b, -1.0);
+  return r.norm2() / b.norm2();
+}
+}  // namespace
+
+// Newton's confirming solve (LinearSolver::solve's from_x): CG goes on from a
+// looser solution of the same system and reaches the tight tolerance,
+// relative to |b| as from 0, in fewer iterations; without from_x whatever x
+// holds is ignored (CG starts from 0); a start worse than 0 is dropped.
+TEST(LinearSolverMpi, FromXGoesOnFromTheLooseSolutionAndOtherwiseStartsAtZero) {
+  auto comm = Tpetra::getDefaultComm();
+  for (const char* prec : {"NONE", "BLOCK_CHOLMOD"}) {
+    if (comm->getSize() == 1 && std::string(prec) == "BLOCK_CHOLMOD") continue;  // one block: exact in 1 iteration
+    auto A = laplacian(comm);
+    LinearSolver solver(cg_with(prec), comm);
+    solver.set_matrix(A);
+    Vector b(A->getRowMap()), x(A->getRowMap()), x0(A->getRowMap());
+    b.randomize();
+    const auto loose = solver.solve(b, x, 1e-3);
+    EXPECT_EQ(loose.tolerance, 1e-3) << prec;
+    const double rl = relative_residual(*A, x, b);
+    EXPECT_LT(rl, 1e-3) << prec;
+    EXPECT_GT(rl, 1e-12) << prec;
+    const auto warm = solver.solve(b, x, 0.0, /*from_x=*/true);
+    EXPECT_LT(relative_residual(*A, x, b), 1e-12) << prec;
+    x0.putScalar(123.0);  // ignored without from_x
+    const auto cold = solver.solve(b, x0, 0.0);
+    EXPECT_LT(relative_residual(*A, x0, b), 1e-12) << prec;
+    Vector z(A->getRowMap());
+    const auto zero = solver.solve(b, z, 0.0);  // from an x that is 0 already
+    EXPECT_EQ(cold.iterations, zero.iterations) << prec;
+    EXPECT_LT(warm.iterations, cold.iterations) << prec;
+    EXPECT_GE(warm.iterations, 1) << prec;
+    // A start far worse than 0 goes to 0: the same iterations as from 0.
+    x0.putScalar(1e6);
+    const auto bad = solver.solve(b, x0, 0.0, true);
+    EXPECT_EQ(bad.iterations, zero.iterations) << prec;
+    EXPECT_LT(relative_residual(*A, x0, b), 1e-12) << prec;
+    if (comm->getRank() == 0)
+      std::cout << "  " << prec << " on " << comm->getSize() << " rank(s): " << warm.iterations
+                << " CG iterations from the 1e-3 solution, " << cold.iterations << " from 0\n";
+  }
+}
