@@ -57,6 +57,14 @@ double relative_residual(const Matrix& A, const Vector& x, const Vector& b) {
   return r.norm2() / b.norm2();
 }
 
+// shift_i (1 + u_i), u_i uniform in [-spread, spread] (seed 7): a Newton-like change of the values.
+std::vector<double> perturbed(std::vector<double> shift, double spread) {
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> u(-spread, spread);
+  for (double& s : shift) s *= 1.0 + u(rng);
+  return shift;
+}
+
 struct Fixture {
   std::vector<double> shift = std::vector<double>(kN, 1.0);
   RCP<Matrix> A = laplacian(shift);
@@ -109,10 +117,7 @@ TEST(CholmodReuse, NearbyValuesAreSolvedByCgOnThePreviousFactor) {
 // reuse tolerance does not tighten it.
 TEST(CholmodReuse, ALooserToleranceStopsCgEarlierAndIsReported) {
   Fixture f;
-  std::mt19937 rng(7);
-  std::uniform_real_distribution<double> u(-0.3, 0.3);
-  auto s2 = f.shift;
-  for (double& s : s2) s *= 1.0 + u(rng);
+  const auto s2 = perturbed(f.shift, 0.3);
   auto solve_at = [&](double tol, CholmodDirect::Result& r, Vector& x) {
     CholmodDirect solver(CholmodReuse{20, 1e-10});
     solver.set_matrix(f.A);
@@ -152,10 +157,7 @@ TEST(CholmodReuse, ALooserToleranceStopsCgEarlierAndIsReported) {
 // iteration and is returned as it is.
 TEST(CholmodReuse, TheConfirmingSolveGoesOnFromTheLooseSolution) {
   Fixture f;
-  std::mt19937 rng(7);
-  std::uniform_real_distribution<double> u(-0.3, 0.3);
-  auto s2 = f.shift;
-  for (double& s : s2) s *= 1.0 + u(rng);
+  const auto s2 = perturbed(f.shift, 0.3);
   CholmodDirect solver(CholmodReuse{20, 1e-10});
   solver.set_matrix(f.A);
   ASSERT_TRUE(solver.solve(f.b, f.x).factorised);
