@@ -401,37 +401,47 @@ NewtonStats NewtonSolver<dim>::minimize(const IncrementalPotential& ip, View1 x,
       st.reuse_cg_iterations += r.reuse_cg_iterations;
       st.stale_retries += r.stale_retries;
     };
+    const auto wgt = ip.weight;
+    const bool has_w = wgt.extent(0) > 0;
+    // The solved direction into dir, with the exact prescribed and slip-normal
+    // parts (not the solver's rounding of them); returns its weighted max
+    // norm over all ranks.
+    auto take_direction = [&]() {
+      m.dofs.to_local(*m.p, dir);
+      double norm = 0;
+      Kokkos::parallel_reduce(
+          "newton_dir_norm", Kokkos::RangePolicy<ExecSpace>(0, x.extent(0)),
+          KOKKOS_LAMBDA(const LO i, double& acc) {
+            if (pres(i)) dir(i) = dxp(i);
+            acc = std::fmax(acc, std::fabs(dir(i)) * (has_w ? wgt(i) : 1.0));
+          },
+          Kokkos::Max<double>(norm));
+      if (m.dofs.slip().count() > 0) {
+        m.dofs.slip().fix_direction(dir);
+        Kokkos::parallel_reduce(
+            "newton_dir_norm_slip", Kokkos::RangePolicy<ExecSpace>(0, x.extent(0)),
+            KOKKOS_LAMBDA(const LO i, double& acc) { acc = std::fmax(acc, std::fabs(dir(i)) * (has_w ? wgt(i) : 1.0)); },
+            Kokkos::Max<double>(norm));
+      }
+      norm = m.all_max(norm);
+      if (!std::isfinite(norm)) throw SolverError("Newton direction is not finite (linear solve produced NaN/Inf)");
+      return norm;
+    };
+    // The largest step along dir the terms allow (CCD, inversion), all ranks.
+    auto step_bound = [&]() {
+      for (const auto* t : m.dofs.terms()) t->prepare_direction(x, dir);
+      double bound = std::numeric_limits<double>::infinity();
+      for (const auto* t : m.dofs.terms()) bound = std::min(bound, t->max_step(x, dir));
+      return m.all_min(bound);
+    };
+
     const LinearSolveStats ls = solve_direction(forcing, false);
     count_solve(ls);
-    m.dofs.to_local(*m.p, dir);
+    double p_inf = take_direction();
     st.solve_s += timer.seconds();
 
     timer.reset();
-    double p_inf = 0;
-    const auto wgt = ip.weight;
-    const bool has_w = wgt.extent(0) > 0;
-    Kokkos::parallel_reduce(
-        "newton_dir_norm", Kokkos::RangePolicy<ExecSpace>(0, x.extent(0)),
-        KOKKOS_LAMBDA(const LO i, double& acc) {
-          if (pres(i)) dir(i) = dxp(i);  // exact, not the solver's rounding of it
-          acc = std::fmax(acc, std::fabs(dir(i)) * (has_w ? wgt(i) : 1.0));
-        },
-        Kokkos::Max<double>(p_inf));
-    if (m.dofs.slip().count() > 0) {  // exact normal part at slip nodes, as for prescribed DOFs
-      m.dofs.slip().fix_direction(dir);
-      Kokkos::parallel_reduce(
-          "newton_dir_norm_slip", Kokkos::RangePolicy<ExecSpace>(0, x.extent(0)),
-          KOKKOS_LAMBDA(const LO i, double& acc) { acc = std::fmax(acc, std::fabs(dir(i)) * (has_w ? wgt(i) : 1.0)); },
-          Kokkos::Max<double>(p_inf));
-    }
-    p_inf = m.all_max(p_inf);
-    if (!std::isfinite(p_inf))
-      throw SolverError("Newton direction is not finite (linear solve produced NaN/Inf)");
-
-    for (const auto* t : m.dofs.terms()) t->prepare_direction(x, dir);
-    double a_max = std::numeric_limits<double>::infinity();
-    for (const auto* t : m.dofs.terms()) a_max = std::min(a_max, t->max_step(x, dir));
-    a_max = m.all_min(a_max);
+    double a_max = step_bound();
     double alpha = std::min(1.0, 0.9 * a_max);
     bool converged = p_inf / ip.dt < eps && pres_left == 0.0;
     if (it == 0) st.first_p_dt = pres_left == 0.0 ? p_inf / ip.dt : std::numeric_limits<double>::infinity();
@@ -441,31 +451,12 @@ NewtonStats NewtonSolver<dim>::minimize(const IncrementalPotential& ip, View1 x,
       // from the loose one (m.p still holds it: the same matrix and b).
       timer.reset();
       count_solve(solve_direction(0.0, true));
-      m.dofs.to_local(*m.p, dir);
-      p_inf = 0;
-      Kokkos::parallel_reduce(
-          "newton_dir_norm_tight", Kokkos::RangePolicy<ExecSpace>(0, x.extent(0)),
-          KOKKOS_LAMBDA(const LO i, double& acc) {
-            if (pres(i)) dir(i) = dxp(i);
-            acc = std::fmax(acc, std::fabs(dir(i)) * (has_w ? wgt(i) : 1.0));
-          },
-          Kokkos::Max<double>(p_inf));
-      if (m.dofs.slip().count() > 0) {
-        m.dofs.slip().fix_direction(dir);
-        Kokkos::parallel_reduce(
-            "newton_dir_norm_tight_slip", Kokkos::RangePolicy<ExecSpace>(0, x.extent(0)),
-            KOKKOS_LAMBDA(const LO i, double& acc) { acc = std::fmax(acc, std::fabs(dir(i)) * (has_w ? wgt(i) : 1.0)); },
-            Kokkos::Max<double>(p_inf));
-      }
-      p_inf = m.all_max(p_inf);
+      p_inf = take_direction();
       converged = p_inf / ip.dt < eps;
       if (it == 0) st.first_p_dt = p_inf / ip.dt;
       st.solve_s += timer.seconds();
       timer.reset();
-      for (const auto* t : m.dofs.terms()) t->prepare_direction(x, dir);
-      a_max = std::numeric_limits<double>::infinity();
-      for (const auto* t : m.dofs.terms()) a_max = std::min(a_max, t->max_step(x, dir));
-      a_max = m.all_min(a_max);
+      a_max = step_bound();
       alpha = std::min(1.0, 0.9 * a_max);
     }
     if (!project) ++st.exact_hessian_iterations;
