@@ -13,6 +13,7 @@
 
 #include "solver/cholmod_common.hpp"
 #include "solver/cholmod_views.hpp"
+#include "solver/single_factor.hpp"
 #include "solver/solver_error.hpp"
 
 namespace bfemp {
@@ -32,6 +33,8 @@ struct BlockCholmod::Impl {
   Kokkos::View<double*, MemSpace> values;         // the block's values, gathered by compute()
   bool analysed = false;
   bool factored = false;
+  bool want_single = false;
+  SingleFactor single;  // the factor in float (want_single), copied by compute()
   double fl = 0, lnz = 0;  // CHOLMOD's analysis: factorisation flops, nonzeros of L
   // Overlap 1 (n_ghost > 0): the ghost rows (imported from their owners into
   // a matrix on ghost_map with a fixed graph), the block's entries from them
@@ -60,11 +63,12 @@ struct BlockCholmod::Impl {
 
 // Once per graph (host): which of A's entries lie in this rank's block, in
 // block coordinates (owned rows by local id, then the ghosts), sorted per row.
-BlockCholmod::BlockCholmod(const Teuchos::RCP<const Matrix>& A, int overlap) : impl_(new Impl) {
+BlockCholmod::BlockCholmod(const Teuchos::RCP<const Matrix>& A, int overlap, bool single) : impl_(new Impl) {
   if (overlap != 0 && overlap != 1)
     throw std::invalid_argument("BlockCholmod: overlap " + std::to_string(overlap) + "; expected 0 or 1");
   auto& m = *impl_;
   m.A = A;
+  m.want_single = single;
   const auto& rows = *A->getRowMap();
   const auto& cols = *A->getColMap();
   const auto lcl = A->getLocalMatrixHost();
@@ -178,6 +182,7 @@ void BlockCholmod::compute() {
   cholmod_sparse S = m.view();
   int status = CHOLMOD_OK;
   m.factored = false;
+  m.single.clear();
   {
     CholmodSerialScope serial;
     if (!m.analysed && S.nrow > 0) {
@@ -202,6 +207,7 @@ void BlockCholmod::compute() {
   if (worst == 2)
     throw SolverError("block Cholesky preconditioner (BLOCK_CHOLMOD): CHOLMOD status " + std::to_string(status) +
                       " on this rank (or a failure on another rank)");
+  if (m.want_single && S.nrow > 0) m.single.assign(*m.L);  // (refused: apply() solves in double)
   m.factored = true;
 }
 
@@ -228,7 +234,10 @@ void BlockCholmod::apply(const MultiVec& Xin, MultiVec& Yout, Teuchos::ETransp, 
     }
     Kokkos::fence();
     const double* s = nullptr;
-    if (n > 0) {
+    if (n > 0 && m.single.ready()) {
+      m.single.solve(rhs.data(), rhs.data());
+      s = rhs.data();
+    } else if (n > 0) {
       cholmod_dense B = dense_column_view(rhs.data(), n);
       CholmodSerialScope serial;
       if (!cholmod_l_solve2(CHOLMOD_A, m.L, &B, nullptr, &m.X, nullptr, &m.Y, &m.E, &m.c) || m.c.status != CHOLMOD_OK)
@@ -272,5 +281,6 @@ double BlockCholmod::iteration_flops() const {
 }
 std::size_t BlockCholmod::block_rows() const { return impl_->p.size() - 1; }
 std::size_t BlockCholmod::block_entries() const { return impl_->i.size(); }
+bool BlockCholmod::applies_single() const { return impl_->single.ready(); }
 
 }  // namespace bfemp

@@ -39,8 +39,12 @@ namespace bfemp {
 
 class BlockCholmod : public Operator {
  public:
-  // overlap: 0 (block Jacobi on the owned rows) or 1 (see above).
-  explicit BlockCholmod(const Teuchos::RCP<const Matrix>& A, int overlap = 0);
+  // overlap: 0 (block Jacobi on the owned rows) or 1 (see above). single:
+  // apply() solves with a float copy of the factor in double arithmetic
+  // (solver/single_factor.hpp: the exact inverse of the rounded factor, so
+  // still a fixed symmetric positive definite preconditioner; half the bytes
+  // per triangular solve); a simplicial factor keeps CHOLMOD's double solve.
+  explicit BlockCholmod(const Teuchos::RCP<const Matrix>& A, int overlap = 0, bool single = false);
   ~BlockCholmod() override;
   BlockCholmod(const BlockCholmod&) = delete;
   BlockCholmod& operator=(const BlockCholmod&) = delete;
@@ -67,6 +71,8 @@ class BlockCholmod : public Operator {
   // entries (both triangles).
   std::size_t block_rows() const;
   std::size_t block_entries() const;
+  // apply() uses the float copy (single requested and the factor supernodal).
+  bool applies_single() const;
 
  private:
   struct Impl;

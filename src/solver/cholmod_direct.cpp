@@ -13,6 +13,7 @@
 #include "solver/blas_threads.hpp"
 #include "solver/cholmod_common.hpp"
 #include "solver/cholmod_views.hpp"
+#include "solver/single_factor.hpp"
 #include "solver/solver_error.hpp"
 
 namespace bfemp {
@@ -46,6 +47,8 @@ struct CholmodDirect::Impl {
   std::vector<SuiteSparse_long> p, i;  // CHOLMOD's index type; built once per graph
   bool analysed = false;
   bool factor_ok = false;  // L holds a complete numeric factor of this graph
+  SingleFactor single;      // L in float (reuse.single), made at the first CG on it
+  bool single_tried = false;  // assign ran on this factor (it may have refused it)
   bool spare_wanted = false;  // a non-positive pivot was met in this step: keep L while refactorising
   Reuse reuse;
   int budget = 0;  // CG iterations allowed on the previous factor (reuse.max_iterations, or by cost)
@@ -86,6 +89,8 @@ void CholmodDirect::set_matrix(const Teuchos::RCP<const Matrix>& A) {
   if (m.spare) cholmod_l_free_factor(&m.spare, &m.c);
   m.analysed = false;
   m.factor_ok = false;
+  m.single.clear();
+  m.single_tried = false;
   if (m.reuse.max_iterations > 0 && m.cg_x.extent(0) != n) {
     m.cg_x = Impl::V("cholmod_cg_x", n);
     m.cg_r = Impl::V("cholmod_cg_r", n);
@@ -113,8 +118,8 @@ double dot(const Kokkos::View<double*, MemSpace>& a, const Kokkos::View<double*,
 
 // CG on A x = b preconditioned by the stored factor; true when it reached the
 // tolerance (x then in m.cg_x). `its` counts the iterations run.
-static bool cg_on_old_factor(CholmodDirect::Reuse reuse, cholmod_common& c, cholmod_factor* L, cholmod_dense*& X,
-                             cholmod_dense*& Y, cholmod_dense*& E, const Matrix& A, const Vector& b,
+static bool cg_on_old_factor(CholmodDirect::Reuse reuse, cholmod_common& c, cholmod_factor* L, SingleFactor& single,
+                             cholmod_dense*& X, cholmod_dense*& Y, cholmod_dense*& E, const Matrix& A, const Vector& b,
                              Kokkos::View<double*, MemSpace> x, Kokkos::View<double*, MemSpace> r,
                              Kokkos::View<double*, MemSpace> z, Kokkos::View<double*, MemSpace> p,
                              Kokkos::View<double*, MemSpace> q, const Vector* x0, int& its) {
@@ -162,6 +167,11 @@ static bool cg_on_old_factor(CholmodDirect::Reuse reuse, cholmod_common& c, chol
   const double stop = reuse.tolerance * bn;
   if (r0n <= stop) return true;
   auto precondition = [&]() {  // z = (L L^T)^-1 r
+    if (single.ready()) {
+      Kokkos::fence();
+      single.solve(r.data(), z.data());
+      return true;
+    }
     cholmod_dense R = dense_column_view(r.data(), n);
     {
       CholmodSerialScope serial;
@@ -231,7 +241,12 @@ CholmodDirect::Result CholmodDirect::solve(const Vector& b, Vector& x, double to
     r.max_iterations = m.budget;
     r.tolerance = std::max(r.tolerance, tolerance);
     res.cg_budget = m.budget;
-    const bool ok = cg_on_old_factor(r, m.c, m.L, m.X, m.Y, m.E, *m.A, b, m.cg_x, m.cg_r, m.cg_z, m.cg_p,
+    if (m.reuse.single && !m.single_tried) {
+      m.single.assign(*m.L);
+      m.single_tried = true;
+    }
+    res.cg_single = m.single.ready();
+    const bool ok = cg_on_old_factor(r, m.c, m.L, m.single, m.X, m.Y, m.E, *m.A, b, m.cg_x, m.cg_r, m.cg_z, m.cg_p,
                                      m.cg_q, from_x ? &x : nullptr, res.cg_iterations);
     res.cg_s = cg_timer.seconds();
     if (ok) {
@@ -279,6 +294,7 @@ CholmodDirect::Result CholmodDirect::solve(const Vector& b, Vector& x, double to
   }
   cholmod_factor* target = keep ? m.spare : m.L;
   if (!keep) m.factor_ok = false;
+
   bool factorised;
   {
     BlasTeamScope team(m.flops);  // a large factorisation: the BLAS on the team's cores
@@ -294,6 +310,8 @@ CholmodDirect::Result CholmodDirect::solve(const Vector& b, Vector& x, double to
   }
   if (keep) std::swap(m.L, m.spare);
   m.factor_ok = true;
+  m.single.clear();
+  m.single_tried = false;
   res.factor_s = factor_timer.seconds();
   auto bv = b.getLocalViewDevice(Tpetra::Access::ReadOnly);
   cholmod_dense B = dense_column_view(const_cast<double*>(bv.data()), S.nrow);

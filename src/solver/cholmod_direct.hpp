@@ -63,6 +63,11 @@ struct CholmodReuse {
   // LinearSolver: CG on the previous factor may stop at the Newton forcing
   // term (solve()'s `tolerance`), not at `tolerance` ('forcing term').
   bool adaptive = true;
+  // CG on the previous factor preconditions with a float copy of it, applied
+  // in double arithmetic (solver/single_factor.hpp): half the bytes per
+  // triangular solve. Supernodal factors only (a simplicial one, or one with
+  // entries outside float's range, is applied in double as before).
+  bool single = true;
   static constexpr double kBlas3Advantage = 4.0;
   static constexpr int kMaxByCost = 200;
 };
@@ -79,6 +84,7 @@ class CholmodDirect {
     bool factorised = false;  // the numeric factorisation ran in this call
     int cg_iterations = 0;    // CG iterations on the previous factor (also when CG gave up)
     int cg_budget = 0;        // the iteration budget CG had (CholmodReuse::by_cost)
+    bool cg_single = false;   // CG was preconditioned by the factor's float copy (CholmodReuse::single)
     double factor_s = 0;      // seconds in the symbolic analysis and numeric factorisation
     double cg_s = 0;          // seconds in CG on the previous factor (also when it gave up)
     double tolerance = 0;     // relative residual the result was solved to (0: factorised, exact)

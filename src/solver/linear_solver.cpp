@@ -105,6 +105,12 @@ Teuchos::RCP<const Teuchos::ParameterList> linear_solver_schema() {
       "size: linear solve 0.13 -> 0.095 s per contact step); fixed: always "
       "'reuse tolerance'",
       Teuchos::tuple<std::string>("adaptive", "fixed"), &ch);
+  Teuchos::setStringToIntegralParameter<int>(
+      "reuse precision", "single",
+      "single: CG on the previous factor applies a float copy of it (double arithmetic; "
+      "solver/single_factor.hpp), half the bytes per triangular solve; double: CHOLMOD's own "
+      "solve on the double factor. The answer's tolerance is the same either way",
+      Teuchos::tuple<std::string>("single", "double"), &ch);
   auto& cg = pl->sublist("CG", false,
                          "Belos conjugate gradients with an Ifpack2 or MueLu preconditioner");
   cg.set("tolerance", 1e-12,
@@ -151,6 +157,12 @@ Teuchos::RCP<const Teuchos::ParameterList> linear_solver_schema() {
          "refactorise only when the CG iterations the stale factor has cost since its "
          "factorisation (against the rate right after it) outweigh one factorisation; false: "
          "factorise at every solve");
+  Teuchos::setStringToIntegralParameter<int>(
+      "block precision", "single",
+      "BLOCK_CHOLMOD: single, apply each rank's factor from a float copy in double arithmetic "
+      "(solver/single_factor.hpp; half the bytes per triangular solve, the same CG tolerance); "
+      "double: CHOLMOD's own solve",
+      Teuchos::tuple<std::string>("single", "double"), &cg);
   auto& ifp = cg.sublist("Ifpack2", false,
                          "parameters passed to the Ifpack2 preconditioner (checked by bfemp)");
   ifp.disableRecursiveValidation();
@@ -203,6 +215,7 @@ struct LinearSolver::Impl {
   int cg_max_iters = 2000;
   int muelu_rebuild_every = 10;
   int block_overlap = 1;
+  bool block_single = true;
   // BLOCK_CHOLMOD factor reuse: whether the factor holds A's values of some
   // earlier solve of this graph and step, a factorisation's cost in CG
   // iterations (flop counts, the costliest rank's), the CG iterations per
@@ -236,12 +249,13 @@ LinearSolver::LinearSolver(const ParameterList& params, const RCP<const Comm>& c
     if (ch.isParameter("reuse tolerance")) impl_->reuse.tolerance = ch.get<double>("reuse tolerance");
     if (ch.isParameter("reuse by cost")) impl_->reuse.by_cost = ch.get<bool>("reuse by cost");
     if (ch.isParameter("forcing term")) impl_->reuse.adaptive = ch.get<std::string>("forcing term") == "adaptive";
+    if (ch.isParameter("reuse precision")) impl_->reuse.single = ch.get<std::string>("reuse precision") == "single";
   }
   // Cholmod keys away from their defaults would be ignored by another solver: refuse them.
   const CholmodDirect::Reuse defaults;
   const bool ch_set = impl_->reuse.max_iterations != kCholmodReuseIterations ||
                       impl_->reuse.tolerance != defaults.tolerance || !impl_->reuse.by_cost ||
-                      impl_->reuse.adaptive != defaults.adaptive;
+                      impl_->reuse.adaptive != defaults.adaptive || impl_->reuse.single != defaults.single;
   if (kind_ != LinearSolverKind::Cholmod && ch_set)
     throw std::invalid_argument("scene sublist 'Linear Solver/Cholmod' is set but 'Linear Solver/type' is " +
                                 std::string(linear_solver_name(kind_)) + ": expected type Cholmod for it, or no such sublist");
@@ -253,12 +267,14 @@ LinearSolver::LinearSolver(const ParameterList& params, const RCP<const Comm>& c
   impl_->prec_name = cg.get<std::string>("preconditioner");
   if (cg.isParameter("block overlap")) impl_->block_overlap = cg.get<int>("block overlap");
   if (cg.isParameter("block reuse")) impl_->block_reuse = cg.get<bool>("block reuse");
+  if (cg.isParameter("block precision")) impl_->block_single = cg.get<std::string>("block precision") == "single";
   // BLOCK_CHOLMOD keys away from their defaults would be ignored by another preconditioner: refuse them.
   if (kind_ == LinearSolverKind::CG && impl_->prec_name != "BLOCK_CHOLMOD" &&
-      (impl_->block_overlap != 1 || !impl_->block_reuse))
+      (impl_->block_overlap != 1 || !impl_->block_reuse || !impl_->block_single))
     throw std::invalid_argument(std::string("scene key 'Linear Solver/CG/") +
                                 (impl_->block_overlap != 1 ? "block overlap' = " + std::to_string(impl_->block_overlap)
-                                                           : std::string("block reuse' = false")) +
+                                 : !impl_->block_reuse     ? std::string("block reuse' = false")
+                                                           : std::string("block precision' = double")) +
                                 " but 'Linear Solver/CG/preconditioner' is " + impl_->prec_name +
                                 ": expected BLOCK_CHOLMOD for it, or the key left at its default");
   impl_->ifpack2 = cg.sublist("Ifpack2");
@@ -316,7 +332,8 @@ std::string LinearSolver::describe() const {
     if (impl_->reuse.max_iterations > 0)
       s << "; up to " << impl_->reuse.max_iterations
         << (impl_->reuse.by_cost ? " (or one factorisation's cost)" : "") << " CG iterations on the previous factor, tol "
-        << impl_->reuse.tolerance << (impl_->reuse.adaptive ? ", adaptive forcing term" : "");
+        << impl_->reuse.tolerance << (impl_->reuse.adaptive ? ", adaptive forcing term" : "")
+        << (impl_->reuse.single ? ", float copy" : "");
     s << ")";
     return s.str();
   }
@@ -342,7 +359,7 @@ void LinearSolver::set_matrix(const RCP<const Matrix>& A) {
     if (m.muelu) {
       m.muelu->set_matrix(A);
     } else if (m.prec_name == "BLOCK_CHOLMOD") {
-      m.block = rcp(new BlockCholmod(A, m.block_overlap));
+      m.block = rcp(new BlockCholmod(A, m.block_overlap, m.block_single));
       m.block_valid = false;
     } else if (m.prec_name != "NONE") {
       m.prec = Ifpack2::Factory::create<Tpetra::RowMatrix<double, LO, GO, Node>>(m.prec_name, A);

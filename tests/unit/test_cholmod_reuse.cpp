@@ -438,3 +438,53 @@ TEST(CholmodReuse, TheBudgetByCostExceedsTheFixedOneForDenseFactors) {
     }
   }
 }
+
+// 'reuse precision: single' (CholmodReuse::single): CG on the previous factor
+// preconditions with its float copy (solver/single_factor.hpp; supernodal
+// factors only, as this dense one). The float rounding (1e-7) is far below
+// the 5 % change of the matrix since the factorisation, so CG takes the
+// iterations the double factor takes (+-1) and reaches the same tolerance;
+// the two answers agree to it. A simplicial factor (the 20 x 20 Laplacian)
+// keeps CHOLMOD's double solve.
+TEST(CholmodReuse, TheFloatCopyPreconditionsAsTheDoubleFactorDoes) {
+  constexpr int n = 600;
+  std::vector<double> scale(n, 1.0);
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> u(-0.05, 0.05);
+  auto moved = scale;
+  for (double& s : moved) s *= 1.0 + u(rng);
+  int its[2] = {0, 0};
+  std::vector<Vector> answers;
+  for (bool single : {false, true}) {
+    SCOPED_TRACE(single ? "single" : "double");
+    auto A = dense_spd(n, scale);
+    Vector b(A->getRowMap()), x(A->getRowMap());
+    b.putScalar(1.0);
+    CholmodReuse reuse{40, 1e-12};
+    reuse.single = single;
+    CholmodDirect solver(reuse);
+    solver.set_matrix(A);
+    ASSERT_TRUE(solver.solve(b, x).factorised);
+    copy_values(*dense_spd(n, moved), *A);
+    const auto r = solver.solve(b, x);
+    ASSERT_FALSE(r.factorised);
+    EXPECT_EQ(r.cg_single, single);
+    EXPECT_LT(relative_residual(*A, x, b), 1e-12);
+    its[single] = r.cg_iterations;
+    answers.emplace_back(x, Teuchos::Copy);
+  }
+  EXPECT_GE(its[0], 3);
+  EXPECT_LE(std::abs(its[1] - its[0]), 1) << its[0] << " (double) against " << its[1] << " (single)";
+  answers[1].update(-1.0, answers[0], 1.0);
+  EXPECT_LT(answers[1].norm2() / answers[0].norm2(), 1e-10);
+  std::printf("  CG on the previous factor to 1e-12: %d iterations (double factor), %d (float copy)\n", its[0],
+              its[1]);
+  Fixture f;  // simplicial
+  CholmodDirect solver(CholmodReuse{20, 1e-10});
+  solver.set_matrix(f.A);
+  ASSERT_TRUE(solver.solve(f.b, f.x).factorised);
+  copy_values(*laplacian(perturbed(f.shift, 0.3)), *f.A);
+  const auto r = solver.solve(f.b, f.x);
+  ASSERT_FALSE(r.factorised);
+  EXPECT_FALSE(r.cg_single);
+}
