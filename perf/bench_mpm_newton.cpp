@@ -9,6 +9,7 @@
 //
 //   bench_mpm_newton [--configs 2d/1e4,2d/1e5,2d/1e6,3d/1e5] [--solvers Cholmod,CG]
 //                    [--steps N] [--dt 0.01] [--out mpm_newton.json]
+//                    [--linear 'Cholmod/reuse precision=double' ...]  (keys under 'Linear Solver': an A/B)
 //
 // Threads: Kokkos gets OMP_NUM_THREADS (perf/run_benchmarks.sh --bench
 // bench_mpm_newton runs 1 and 2 threads and merges). See perf/README.md.
@@ -55,13 +56,15 @@ struct Options {
   double dt = 0.01;
   bool no_skip = false;
   std::string out = "mpm_newton.json";
+  std::vector<std::string> linear;  // --linear 'SUBLIST/KEY=VALUE' under 'Linear Solver'
 };
 
 [[noreturn]] void usage(const std::string& msg) {
   std::ostream& os = msg.empty() ? std::cout : std::cerr;
   if (!msg.empty()) os << "bench_mpm_newton: " << msg << "\n";
   os << "usage: bench_mpm_newton [--configs 2d/1e4,2d/1e5,2d/1e6,3d/1e4,3d/1e5]\n"
-        "                        [--solvers Cholmod,KLU2,CG] [--steps N] [--dt S] [--no-skip] [--out FILE]\n";
+        "                        [--solvers Cholmod,KLU2,CG] [--steps N] [--dt S] [--no-skip] [--out FILE]\n"
+        "                        [--linear 'Cholmod/reuse precision=double' ...]  (keys under 'Linear Solver')\n";
   std::exit(msg.empty() ? 0 : 2);
 }
 
@@ -92,6 +95,8 @@ Options parse(int argc, char** argv) {
       o.no_skip = true;
     } else if (a == "--out") {
       o.out = value();
+    } else if (a == "--linear") {
+      o.linear.push_back(value());
     } else if (a == "--help" || a == "-h") {
       usage("");
     } else {
@@ -103,6 +108,26 @@ Options parse(int argc, char** argv) {
 }
 
 
+
+// 'SUBLIST/.../KEY=VALUE' into the linear solver list (an A/B of a solver
+// key), VALUE read as the schema's type of KEY.
+void set_linear_key(Teuchos::ParameterList& ls, const std::string& kv) {
+  const auto eq = kv.find('=');
+  if (eq == std::string::npos) usage("--linear '" + kv + "': expected KEY=VALUE");
+  std::string path = kv.substr(0, eq);
+  const std::string value = kv.substr(eq + 1);
+  Teuchos::ParameterList* pl = &ls;
+  for (auto slash = path.find('/'); slash != std::string::npos; slash = path.find('/')) {
+    if (!pl->isSublist(path.substr(0, slash))) usage("--linear '" + kv + "': no sublist '" + path.substr(0, slash) + "'");
+    pl = &pl->sublist(path.substr(0, slash));
+    path = path.substr(slash + 1);
+  }
+  if (!pl->isParameter(path)) usage("--linear '" + kv + "': no key '" + path + "'");
+  if (pl->isType<int>(path)) pl->set(path, std::stoi(value));
+  else if (pl->isType<double>(path)) pl->set(path, std::stod(value));
+  else if (pl->isType<bool>(path)) pl->set(path, value == "true");
+  else pl->set(path, value);
+}
 
 // The block: unit square/cube [0,1]^dim, ppc 4 (2D) / 8 (3D), dx giving about
 // `target` particles, on a no-slip half-plane ground at y = 0.
@@ -165,6 +190,7 @@ Json run_case(const std::string& size, const std::string& solver, const Options&
     double dx = 0;
     Kokkos::Timer timer;
     auto setup = mpm_block<dim>(std::stod(size), solver, o.dt, dx);
+    for (const std::string& kv : o.linear) set_linear_key(setup.linear_solver, kv);
     const long long np = static_cast<long long>(setup.mpm->particles.size());
     Simulation<dim> sim(setup, comm);
     Kokkos::fence();

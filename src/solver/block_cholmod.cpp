@@ -34,7 +34,9 @@ struct BlockCholmod::Impl {
   bool analysed = false;
   bool factored = false;
   bool want_single = false;
-  SingleFactor single;  // the factor in float (want_single), copied by compute()
+  SingleFactor single;  // the factor in float (want_single), copied by prepare_solve() once worth it
+  int applies = 0;      // apply() calls since the factorisation
+  bool single_tried = false;  // assign ran on this factor
   double fl = 0, lnz = 0;  // CHOLMOD's analysis: factorisation flops, nonzeros of L
   // Overlap 1 (n_ghost > 0): the ghost rows (imported from their owners into
   // a matrix on ghost_map with a fixed graph), the block's entries from them
@@ -207,7 +209,8 @@ void BlockCholmod::compute() {
   if (worst == 2)
     throw SolverError("block Cholesky preconditioner (BLOCK_CHOLMOD): CHOLMOD status " + std::to_string(status) +
                       " on this rank (or a failure on another rank)");
-  if (m.want_single && S.nrow > 0) m.single.assign(*m.L);  // (refused: apply() solves in double)
+  m.applies = 0;
+  m.single_tried = false;
   m.factored = true;
 }
 
@@ -234,6 +237,7 @@ void BlockCholmod::apply(const MultiVec& Xin, MultiVec& Yout, Teuchos::ETransp, 
     }
     Kokkos::fence();
     const double* s = nullptr;
+    ++m.applies;
     if (n > 0 && m.single.ready()) {
       m.single.solve(rhs.data(), rhs.data());
       s = rhs.data();
@@ -282,5 +286,14 @@ double BlockCholmod::iteration_flops() const {
 std::size_t BlockCholmod::block_rows() const { return impl_->p.size() - 1; }
 std::size_t BlockCholmod::block_entries() const { return impl_->i.size(); }
 bool BlockCholmod::applies_single() const { return impl_->single.ready(); }
+
+void BlockCholmod::prepare_solve() {
+  auto& m = *impl_;
+  if (m.want_single && m.factored && !m.single_tried && m.applies >= SingleFactor::kWorthAfter &&
+      m.p.size() > 1) {
+    m.single.assign(*m.L);  // (refused: the solves stay in double)
+    m.single_tried = true;
+  }
+}
 
 }  // namespace bfemp

@@ -40,7 +40,8 @@ namespace bfemp {
 class BlockCholmod : public Operator {
  public:
   // overlap: 0 (block Jacobi on the owned rows) or 1 (see above). single:
-  // apply() solves with a float copy of the factor in double arithmetic
+  // apply() solves with a float copy of the factor in double arithmetic (from
+  // the first solve after the factor has served a few, see prepare_solve)
   // (solver/single_factor.hpp: the exact inverse of the rounded factor, so
   // still a fixed symmetric positive definite preconditioner; half the bytes
   // per triangular solve); a simplicial factor keeps CHOLMOD's double solve.
@@ -71,7 +72,13 @@ class BlockCholmod : public Operator {
   // entries (both triangles).
   std::size_t block_rows() const;
   std::size_t block_entries() const;
-  // apply() uses the float copy (single requested and the factor supernodal).
+  // Before a CG solve with this preconditioner: with `single`, copies the
+  // factor to float once it has served SingleFactor::kWorthAfter applies
+  // (a copy costs about three solves), so the preconditioner never changes
+  // within a CG solve.
+  void prepare_solve();
+  // apply() uses the float copy (single requested, the factor supernodal and
+  // prepare_solve() has copied it).
   bool applies_single() const;
 
  private:

@@ -49,6 +49,7 @@ struct CholmodDirect::Impl {
   bool factor_ok = false;  // L holds a complete numeric factor of this graph
   SingleFactor single;      // L in float (reuse.single), made at the first CG on it
   bool single_tried = false;  // assign ran on this factor (it may have refused it)
+  int cg_on_factor = 0;       // CG iterations run on this factor so far
   bool spare_wanted = false;  // a non-positive pivot was met in this step: keep L while refactorising
   Reuse reuse;
   int budget = 0;  // CG iterations allowed on the previous factor (reuse.max_iterations, or by cost)
@@ -241,7 +242,7 @@ CholmodDirect::Result CholmodDirect::solve(const Vector& b, Vector& x, double to
     r.max_iterations = m.budget;
     r.tolerance = std::max(r.tolerance, tolerance);
     res.cg_budget = m.budget;
-    if (m.reuse.single && !m.single_tried) {
+    if (m.reuse.single && !m.single_tried && m.cg_on_factor >= SingleFactor::kWorthAfter) {
       m.single.assign(*m.L);
       m.single_tried = true;
     }
@@ -249,6 +250,7 @@ CholmodDirect::Result CholmodDirect::solve(const Vector& b, Vector& x, double to
     const bool ok = cg_on_old_factor(r, m.c, m.L, m.single, m.X, m.Y, m.E, *m.A, b, m.cg_x, m.cg_r, m.cg_z, m.cg_p,
                                      m.cg_q, from_x ? &x : nullptr, res.cg_iterations);
     res.cg_s = cg_timer.seconds();
+    m.cg_on_factor += res.cg_iterations;
     if (ok) {
       res.tolerance = r.tolerance;
       auto xv = x.getLocalViewDevice(Tpetra::Access::OverwriteAll);
@@ -312,6 +314,7 @@ CholmodDirect::Result CholmodDirect::solve(const Vector& b, Vector& x, double to
   m.factor_ok = true;
   m.single.clear();
   m.single_tried = false;
+  m.cg_on_factor = 0;
   res.factor_s = factor_timer.seconds();
   auto bv = b.getLocalViewDevice(Tpetra::Access::ReadOnly);
   cholmod_dense B = dense_column_view(const_cast<double*>(bv.data()), S.nrow);

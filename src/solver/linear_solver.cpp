@@ -465,6 +465,7 @@ LinearSolveStats LinearSolver::solve(const Vector& b, Vector& x, double forcing,
       m.block_excess_its = 0;
       stats.factorised = true;
     }
+    m.block->prepare_solve();  // the float copy, once the factor has served enough applies
     M = m.block;
   } else if (!m.prec.is_null()) {
     if (m.reinitialise_each_compute) m.prec->initialize();

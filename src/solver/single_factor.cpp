@@ -6,10 +6,7 @@
 
 namespace bfemp {
 
-void SingleFactor::clear() {
-  n_ = 0;
-  x_.clear();
-}
+void SingleFactor::clear() { n_ = 0; }  // (the buffers stay: the next copy writes over them)
 
 bool SingleFactor::assign(const cholmod_factor& L) {
   clear();

@@ -13,6 +13,7 @@
 
 #include "common/fem_fixtures.hpp"
 #include "solver/cholmod_direct.hpp"
+#include "solver/single_factor.hpp"
 #include "solver/solver_error.hpp"
 
 namespace {
@@ -441,18 +442,20 @@ TEST(CholmodReuse, TheBudgetByCostExceedsTheFixedOneForDenseFactors) {
 
 // 'reuse precision: single' (CholmodReuse::single): CG on the previous factor
 // preconditions with its float copy (solver/single_factor.hpp; supernodal
-// factors only, as this dense one). The float rounding (1e-7) is far below
-// the 5 % change of the matrix since the factorisation, so CG takes the
-// iterations the double factor takes (+-1) and reaches the same tolerance;
-// the two answers agree to it. A simplicial factor (the 20 x 20 Laplacian)
-// keeps CHOLMOD's double solve.
+// factors only, as this dense one), made once CG has run
+// SingleFactor::kWorthAfter iterations on the factor in double. The float
+// rounding (1e-7) is far below the 5 % change of the matrix since the
+// factorisation, so CG on the copy takes the iterations the double factor
+// takes (+-1) and reaches the same tolerance; the two answers agree to it. A
+// simplicial factor (the 20 x 20 Laplacian) keeps CHOLMOD's double solve.
 TEST(CholmodReuse, TheFloatCopyPreconditionsAsTheDoubleFactorDoes) {
   constexpr int n = 600;
   std::vector<double> scale(n, 1.0);
   std::mt19937 rng(11);
   std::uniform_real_distribution<double> u(-0.05, 0.05);
-  auto moved = scale;
+  auto moved = scale, moved2 = scale;
   for (double& s : moved) s *= 1.0 + u(rng);
+  for (double& s : moved2) s *= 1.0 + u(rng);
   int its[2] = {0, 0};
   std::vector<Vector> answers;
   for (bool single : {false, true}) {
@@ -466,6 +469,11 @@ TEST(CholmodReuse, TheFloatCopyPreconditionsAsTheDoubleFactorDoes) {
     solver.set_matrix(A);
     ASSERT_TRUE(solver.solve(b, x).factorised);
     copy_values(*dense_spd(n, moved), *A);
+    const auto first = solver.solve(b, x);  // in double: the factor has served no CG yet
+    ASSERT_FALSE(first.factorised);
+    EXPECT_FALSE(first.cg_single);
+    ASSERT_GE(first.cg_iterations, SingleFactor::kWorthAfter);
+    copy_values(*dense_spd(n, moved2), *A);
     const auto r = solver.solve(b, x);
     ASSERT_FALSE(r.factorised);
     EXPECT_EQ(r.cg_single, single);
@@ -483,8 +491,10 @@ TEST(CholmodReuse, TheFloatCopyPreconditionsAsTheDoubleFactorDoes) {
   CholmodDirect solver(CholmodReuse{20, 1e-10});
   solver.set_matrix(f.A);
   ASSERT_TRUE(solver.solve(f.b, f.x).factorised);
-  copy_values(*laplacian(perturbed(f.shift, 0.3)), *f.A);
-  const auto r = solver.solve(f.b, f.x);
-  ASSERT_FALSE(r.factorised);
-  EXPECT_FALSE(r.cg_single);
+  for (double spread : {0.3, 0.2}) {  // the second solve is past kWorthAfter
+    copy_values(*laplacian(perturbed(f.shift, spread)), *f.A);
+    const auto r = solver.solve(f.b, f.x);
+    ASSERT_FALSE(r.factorised);
+    EXPECT_FALSE(r.cg_single);
+  }
 }
