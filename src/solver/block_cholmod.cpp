@@ -289,8 +289,7 @@ bool BlockCholmod::applies_single() const { return impl_->single.ready(); }
 
 void BlockCholmod::prepare_solve() {
   auto& m = *impl_;
-  if (m.want_single && m.factored && !m.single_tried && m.applies >= SingleFactor::kWorthAfter &&
-      m.p.size() > 1) {
+  if (m.want_single && m.factored && !m.single_tried && m.p.size() > 1 && m.single.worth_copying(*m.L, m.applies)) {
     m.single.assign(*m.L);  // (refused: the solves stay in double)
     m.single_tried = true;
   }

@@ -73,9 +73,9 @@ class BlockCholmod : public Operator {
   std::size_t block_rows() const;
   std::size_t block_entries() const;
   // Before a CG solve with this preconditioner: with `single`, copies the
-  // factor to float once it has served SingleFactor::kWorthAfter applies
-  // (a copy costs about three solves), so the preconditioner never changes
-  // within a CG solve.
+  // factor to float once it has served enough applies to pay for the copy
+  // (SingleFactor::worth_copying), so the preconditioner never changes within
+  // a CG solve.
   void prepare_solve();
   // apply() uses the float copy (single requested, the factor supernodal and
   // prepare_solve() has copied it).

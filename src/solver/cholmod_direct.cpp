@@ -242,7 +242,7 @@ CholmodDirect::Result CholmodDirect::solve(const Vector& b, Vector& x, double to
     r.max_iterations = m.budget;
     r.tolerance = std::max(r.tolerance, tolerance);
     res.cg_budget = m.budget;
-    if (m.reuse.single && !m.single_tried && m.cg_on_factor >= SingleFactor::kWorthAfter) {
+    if (m.reuse.single && !m.single_tried && m.single.worth_copying(*m.L, m.cg_on_factor)) {
       m.single.assign(*m.L);
       m.single_tried = true;
     }

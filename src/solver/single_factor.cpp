@@ -24,6 +24,7 @@ bool SingleFactor::assign(const cholmod_factor& L) {
   pi_.assign(pi, pi + ns + 1);
   px_.assign(px, px + ns + 1);
   s_.assign(s, s + L.ssize);
+  if (L.xsize > x_.capacity()) x_.reserve(L.xsize + L.xsize / 4);
   x_.resize(L.xsize);
   // Round to float; an entry out of float's range, or a diagonal entry that
   // is not a normal positive float, leaves the copy unusable (the caller then

@@ -35,15 +35,20 @@ namespace bfemp {
 
 class SingleFactor {
  public:
-  // Callers copy a factor only once it has served this many solves in
-  // double, so that a factor used once or twice is not copied. A copy reads 8
-  // and writes 4 bytes per entry: 21 ms for 4.7e7 entries at 2 threads (a
-  // 3D block of 52728 DOFs, whose double solve pair takes ~45 ms), and 118 ms
-  // the first time, when the copy's pages are new (its buffers are kept and
-  // grow only). Each later solve saves about half a double solve pair. The
-  // paper twist's factors serve ~65 CG iterations each; bench_mpm_newton's 3D
-  // block's 2-3.
-  static constexpr int kWorthAfter = 4;
+  // Whether L, which has served `served` solves in double, is worth copying
+  // now (ski rental: the solves it has served pay for the copy, so a factor
+  // used once or twice is never copied). A copy reads 8 and writes 4 bytes
+  // per entry: 21 ms for 4.7e7 entries at 2 threads, where a double solve
+  // pair takes ~45 ms and a float one ~25 (a 3D block of 52728 DOFs); but
+  // 118 ms when its buffer must grow (new pages; the buffer is kept, and
+  // grows with a quarter of headroom). So kWorthAfter solves when the copy
+  // fits the buffer, kWorthAfterGrowing when it must grow. The paper twist's
+  // factors serve ~65 CG iterations each, bench_mpm_newton's 2-3.
+  static constexpr int kWorthAfter = 2;
+  static constexpr int kWorthAfterGrowing = 8;
+  bool worth_copying(const cholmod_factor& L, int served) const {
+    return served >= (L.xsize <= x_.capacity() ? kWorthAfter : kWorthAfterGrowing);
+  }
 
   // Copies L's entries rounded to float (and its pattern). false, and the
   // copy emptied, when L is not a numeric real supernodal factor.

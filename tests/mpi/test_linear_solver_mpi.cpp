@@ -499,9 +499,11 @@ TEST(LinearSolverMpi, FromXGoesOnFromTheLooseSolutionAndOtherwiseStartsAtZero) {
 // 'block precision: single' (the default): each rank's BLOCK_CHOLMOD factor
 // is applied from its float copy in double arithmetic (solver/single_factor.hpp),
 // from the first CG solve after the factor has served
-// SingleFactor::kWorthAfter applies (prepare_solve; never within a solve). On a
-// 3D 7-point Laplacian (16^3, a supernodal factor on every rank): no copy
-// before that, a copy after it; with 'block reuse' the second solve on the
+// enough applies to pay for the copy (prepare_solve; never within a solve):
+// SingleFactor::kWorthAfterGrowing for the first copy (a new buffer), then
+// kWorthAfter for a factor of the same size. On a 3D 7-point Laplacian
+// (16^3, a supernodal factor on every rank): no copy before that, a copy
+// after it; with 'block reuse' the second solve on the
 // kept factor runs on the copy and takes the iterations the double factor
 // takes (+-1) to the same answer, at overlap 0 and 1, on any rank count (on
 // one rank the first solve takes 1 iteration, too few applies for a copy).
@@ -530,7 +532,7 @@ TEST(LinearSolverMpi, BlockFactorsFloatCopyPreconditionsAsTheDoubleFactorDoes) {
       dbl.compute();
       MultiVec u(A->getRowMap(), 1), v(A->getRowMap(), 1);
       u.putScalar(1.0);
-      for (int k = 0; k < SingleFactor::kWorthAfter; ++k) {
+      for (int k = 0; k < SingleFactor::kWorthAfterGrowing; ++k) {
         single.prepare_solve();
         dbl.prepare_solve();
         EXPECT_FALSE(single.applies_single()) << "after " << k << " applies";
@@ -541,9 +543,14 @@ TEST(LinearSolverMpi, BlockFactorsFloatCopyPreconditionsAsTheDoubleFactorDoes) {
       dbl.prepare_solve();
       EXPECT_TRUE(single.applies_single());
       EXPECT_FALSE(dbl.applies_single());
-      single.compute();  // a new factor: in double until it has served as many
+      single.compute();  // a new factor: in double until it has served kWorthAfter (the buffer fits it)
+      for (int k = 0; k < SingleFactor::kWorthAfter; ++k) {
+        single.prepare_solve();
+        EXPECT_FALSE(single.applies_single()) << "after " << k << " applies of the new factor";
+        single.apply(u, v);
+      }
       single.prepare_solve();
-      EXPECT_FALSE(single.applies_single());
+      EXPECT_TRUE(single.applies_single());
     }
     int its[2] = {0, 0};
     double err[2] = {0, 0};

@@ -196,6 +196,27 @@ TEST(SingleFactor, SolvesWithTheFloatRoundedFactorExactlyAndSymmetrically) {
   EXPECT_EQ(inplace, z);
 }
 
+// worth_copying: a copy into a new buffer after kWorthAfterGrowing solves, into
+// the kept one (a factor no larger) after kWorthAfter.
+TEST(SingleFactor, ACopyIsWorthItAfterTheSolvesThatPayForIt) {
+  Csc small = laplacian3d(10), large = laplacian3d(12);
+  Cholmod s(CHOLMOD_SUPERNODAL), l(CHOLMOD_SUPERNODAL);
+  s.factorise(small);
+  l.factorise(large);
+  ASSERT_LT(s.L->xsize, l.L->xsize);
+  SingleFactor f;
+  EXPECT_FALSE(f.worth_copying(*s.L, SingleFactor::kWorthAfterGrowing - 1));
+  EXPECT_TRUE(f.worth_copying(*s.L, SingleFactor::kWorthAfterGrowing));
+  ASSERT_TRUE(f.assign(*s.L));
+  f.clear();
+  EXPECT_FALSE(f.worth_copying(*s.L, SingleFactor::kWorthAfter - 1));
+  EXPECT_TRUE(f.worth_copying(*s.L, SingleFactor::kWorthAfter));
+  if (l.L->xsize > s.L->xsize + s.L->xsize / 4) {  // beyond the headroom: the buffer grows
+    EXPECT_FALSE(f.worth_copying(*l.L, SingleFactor::kWorthAfterGrowing - 1));
+  }
+  EXPECT_TRUE(f.worth_copying(*l.L, SingleFactor::kWorthAfterGrowing));
+}
+
 TEST(SingleFactor, RefusesWhatItCannotCopy) {
   Csc a = laplacian3d(8);
   {
