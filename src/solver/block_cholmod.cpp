@@ -287,6 +287,8 @@ std::size_t BlockCholmod::block_rows() const { return impl_->p.size() - 1; }
 std::size_t BlockCholmod::block_entries() const { return impl_->i.size(); }
 bool BlockCholmod::applies_single() const { return impl_->single.ready(); }
 
+void BlockCholmod::new_step() { impl_->single.new_step(); }
+
 void BlockCholmod::prepare_solve() {
   auto& m = *impl_;
   if (m.want_single && m.factored && !m.single_tried && m.p.size() > 1 && m.single.worth_copying(*m.L, m.applies)) {

@@ -77,6 +77,9 @@ class BlockCholmod : public Operator {
   // (SingleFactor::worth_copying), so the preconditioner never changes within
   // a CG solve.
   void prepare_solve();
+  // A new time step: the float copy's ski rental counts this step only
+  // (SingleFactor::new_step), as a restart would.
+  void new_step();
   // apply() uses the float copy (single requested, the factor supernodal and
   // prepare_solve() has copied it).
   bool applies_single() const;

@@ -47,7 +47,7 @@ struct CholmodDirect::Impl {
   std::vector<SuiteSparse_long> p, i;  // CHOLMOD's index type; built once per graph
   bool analysed = false;
   bool factor_ok = false;  // L holds a complete numeric factor of this graph
-  SingleFactor single;      // L in float (reuse.single), made at the first CG on it
+  SingleFactor single;      // L in float (reuse.single), made once L has served a few CG iterations
   bool single_tried = false;  // assign ran on this factor (it may have refused it)
   int cg_on_factor = 0;       // CG iterations run on this factor so far
   bool spare_wanted = false;  // a non-positive pivot was met in this step: keep L while refactorising
@@ -103,6 +103,7 @@ void CholmodDirect::set_matrix(const Teuchos::RCP<const Matrix>& A) {
 
 void CholmodDirect::forget_factor() {  // a new step starts as a restart would
   impl_->factor_ok = false;
+  impl_->single.new_step();
   impl_->spare_wanted = false;
 }
 

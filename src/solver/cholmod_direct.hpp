@@ -26,10 +26,12 @@
 // factorisations of that time step go into a spare factor, so the last good one survives the
 // next failure (memory: twice the factor). With CholmodReuse::single (the default) CG
 // applies a float copy of a supernodal factor, in double arithmetic
-// (solver/single_factor.hpp; made at the first CG on each new factor, 1.5x
-// the factor's memory in all): the iterations stay those of the double
-// factor (paper twist: 1039 in 5 twisting steps either way), each costs half
-// the bytes (38 -> 21 ms per iteration there). The budget by cost below still
+// (solver/single_factor.hpp; made between CG solves once the factor has
+// served a few iterations, SingleFactor::worth_copying; up to 1.6x the
+// factor's memory in all, with the copy's headroom): the iterations stay
+// those of the double factor (paper twist: 1039 in 5 twisting steps either
+// way), each costs about half the bytes (CG on the old factor 40.3 -> 24.5 s
+// there). The budget by cost below still
 // prices an iteration at the double factor's bytes: halving that price
 // raised the paper twist's CG iterations 1039 -> 1232 with the same 16
 // factorisations, so it was not done. solve() reports the relative

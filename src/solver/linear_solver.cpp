@@ -161,7 +161,8 @@ Teuchos::RCP<const Teuchos::ParameterList> linear_solver_schema() {
       "block precision", "single",
       "BLOCK_CHOLMOD: single, apply each rank's factor from a float copy in double arithmetic "
       "(solver/single_factor.hpp; half the bytes per triangular solve, the same CG tolerance); "
-      "double: CHOLMOD's own solve",
+      "double: CHOLMOD's own solve. The copy is made once a factor has served a few applies, so "
+      "with 'block reuse: false' (a factorisation per solve) there is none",
       Teuchos::tuple<std::string>("single", "double"), &cg);
   auto& ifp = cg.sublist("Ifpack2", false,
                          "parameters passed to the Ifpack2 preconditioner (checked by bfemp)");
@@ -347,6 +348,7 @@ std::string LinearSolver::describe() const {
 
 void LinearSolver::forget_factor() {
   if (impl_->cholmod) impl_->cholmod->forget_factor();
+  if (!impl_->block.is_null()) impl_->block->new_step();
   impl_->block_valid = false;
 }
 

@@ -1,6 +1,7 @@
 #include "solver/single_factor.hpp"
 
 #include <Kokkos_Core.hpp>
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -11,7 +12,7 @@ void SingleFactor::clear() { n_ = 0; }  // (the buffers stay: the next copy writ
 bool SingleFactor::assign(const cholmod_factor& L) {
   clear();
   if (!L.is_super || !L.is_ll || L.xtype != CHOLMOD_REAL || L.dtype != CHOLMOD_DOUBLE ||
-      L.itype != CHOLMOD_LONG || L.minor < L.n || L.x == nullptr || L.n == 0)
+      L.itype != CHOLMOD_LONG || L.minor < L.n || L.x == nullptr || L.Perm == nullptr || L.n == 0)
     return false;
   const auto* super = static_cast<const SuiteSparse_long*>(L.super);
   const auto* pi = static_cast<const SuiteSparse_long*>(L.pi);
@@ -24,7 +25,13 @@ bool SingleFactor::assign(const cholmod_factor& L) {
   pi_.assign(pi, pi + ns + 1);
   px_.assign(px, px + ns + 1);
   s_.assign(s, s + L.ssize);
-  if (L.xsize > x_.capacity()) x_.reserve(L.xsize + L.xsize / 4);
+  const std::size_t room = L.xsize + L.xsize / 4;
+  step_room_ = std::max(step_room_, room);
+  if (L.xsize > x_.capacity()) {  // a new buffer: nothing of the old one to keep
+    x_.clear();
+    x_.shrink_to_fit();
+    x_.reserve(room);
+  }
   x_.resize(L.xsize);
   // Round to float; an entry out of float's range, or a diagonal entry that
   // is not a normal positive float, leaves the copy unusable (the caller then

@@ -40,15 +40,19 @@ class SingleFactor {
   // used once or twice is never copied). A copy reads 8 and writes 4 bytes
   // per entry: 21 ms for 4.7e7 entries at 2 threads, where a double solve
   // pair takes ~45 ms and a float one ~25 (a 3D block of 52728 DOFs); but
-  // 118 ms when its buffer must grow (new pages; the buffer is kept, and
-  // grows with a quarter of headroom). So kWorthAfter solves when the copy
-  // fits the buffer, kWorthAfterGrowing when it must grow. The paper twist's
-  // factors serve ~65 CG iterations each, bench_mpm_newton's 2-3.
+  // 118 ms when its buffer must grow (new pages). So kWorthAfter solves when
+  // the copy fits the room this time step's copies have made (the largest
+  // one plus a quarter), kWorthAfterGrowing otherwise. The room counts this
+  // step's copies only (new_step() empties it; the memory itself is kept),
+  // so the decisions do not depend on earlier steps: a restarted run copies
+  // where the run it continues did. The paper twist's factors serve ~65 CG
+  // iterations each, bench_mpm_newton's 2-3.
   static constexpr int kWorthAfter = 2;
   static constexpr int kWorthAfterGrowing = 8;
   bool worth_copying(const cholmod_factor& L, int served) const {
-    return served >= (L.xsize <= x_.capacity() ? kWorthAfter : kWorthAfterGrowing);
+    return served >= (L.xsize <= step_room_ ? kWorthAfter : kWorthAfterGrowing);
   }
+  void new_step() { step_room_ = 0; }
 
   // Copies L's entries rounded to float (and its pattern). false, and the
   // copy emptied, when L is not a numeric real supernodal factor.
@@ -63,6 +67,7 @@ class SingleFactor {
   std::size_t n_ = 0;
   std::vector<SuiteSparse_long> perm_, super_, pi_, px_, s_;
   std::vector<float> x_;
+  std::size_t step_room_ = 0;  // entries this step's copies have made room for (worth_copying)
   std::vector<double> w_;  // the permuted right-hand side, solved in place
   std::vector<double> v_;  // one supernode's rows
 };

@@ -481,6 +481,20 @@ TEST(CholmodReuse, TheFloatCopyPreconditionsAsTheDoubleFactorDoes) {
     EXPECT_LT(relative_residual(*A, x, b), 1e-12);
     its[single] = r.cg_iterations;
     answers.emplace_back(x, Teuchos::Copy);
+    // A refactorisation drops the copy; a new step starts without the room the
+    // last one's copies made (as a restarted run does): a factor that has
+    // served fewer than kWorthAfterGrowing iterations is not copied.
+    solver.forget_factor();
+    ASSERT_TRUE(solver.solve(b, x).factorised);
+    copy_values(*dense_spd(n, moved), *A);
+    const auto loose = solver.solve(b, x, 1e-4);
+    ASSERT_FALSE(loose.factorised);
+    EXPECT_FALSE(loose.cg_single);
+    ASSERT_GE(loose.cg_iterations, SingleFactor::kWorthAfter);
+    ASSERT_LT(loose.cg_iterations, SingleFactor::kWorthAfterGrowing);
+    const auto next = solver.solve(b, x);
+    ASSERT_FALSE(next.factorised);
+    EXPECT_FALSE(next.cg_single) << "the copy would have fitted the last step's room";
   }
   EXPECT_GE(its[0], 3);
   EXPECT_LE(std::abs(its[1] - its[0]), 1) << its[0] << " (double) against " << its[1] << " (single)";

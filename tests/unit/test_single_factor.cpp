@@ -197,7 +197,8 @@ TEST(SingleFactor, SolvesWithTheFloatRoundedFactorExactlyAndSymmetrically) {
 }
 
 // worth_copying: a copy into a new buffer after kWorthAfterGrowing solves, into
-// the kept one (a factor no larger) after kWorthAfter.
+// the room this step's copies made (a factor no larger) after kWorthAfter;
+// new_step() forgets the room.
 TEST(SingleFactor, ACopyIsWorthItAfterTheSolvesThatPayForIt) {
   Csc small = laplacian3d(10), large = laplacian3d(12);
   Cholmod s(CHOLMOD_SUPERNODAL), l(CHOLMOD_SUPERNODAL);
@@ -215,6 +216,11 @@ TEST(SingleFactor, ACopyIsWorthItAfterTheSolvesThatPayForIt) {
     EXPECT_FALSE(f.worth_copying(*l.L, SingleFactor::kWorthAfterGrowing - 1));
   }
   EXPECT_TRUE(f.worth_copying(*l.L, SingleFactor::kWorthAfterGrowing));
+  // A new time step counts its own copies only (a restarted run has none).
+  f.new_step();
+  EXPECT_FALSE(f.worth_copying(*s.L, SingleFactor::kWorthAfterGrowing - 1));
+  ASSERT_TRUE(f.assign(*s.L));
+  EXPECT_TRUE(f.worth_copying(*s.L, SingleFactor::kWorthAfter));
 }
 
 TEST(SingleFactor, RefusesWhatItCannotCopy) {
