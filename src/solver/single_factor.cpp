@@ -101,18 +101,7 @@ inline void backward_block(const float* lk, SuiteSparse_long nsrow, SuiteSparse_
   const float* c[B];
   for (int k = 0; k < B; ++k) c[k] = lk + (j0 + k) * nsrow;
   double acc[B] = {};
-  if constexpr (B == 4) {
-    double a0 = 0, a1 = 0, a2 = 0, a3 = 0;
-#pragma omp simd reduction(+ : a0, a1, a2, a3)
-    for (SuiteSparse_long i = j0 + B; i < nsrow; ++i) {
-      const double vi = v[i];
-      a0 += static_cast<double>(c[0][i]) * vi;
-      a1 += static_cast<double>(c[1][i]) * vi;
-      a2 += static_cast<double>(c[2][i]) * vi;
-      a3 += static_cast<double>(c[3][i]) * vi;
-    }
-    acc[0] = a0, acc[1] = a1, acc[2] = a2, acc[3] = a3;
-  } else if constexpr (B == 8) {
+  if constexpr (B == 8) {
     double a0 = 0, a1 = 0, a2 = 0, a3 = 0, a4 = 0, a5 = 0, a6 = 0, a7 = 0;
 #pragma omp simd reduction(+ : a0, a1, a2, a3, a4, a5, a6, a7)
     for (SuiteSparse_long i = j0 + B; i < nsrow; ++i) {

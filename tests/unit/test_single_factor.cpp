@@ -19,6 +19,7 @@
 #include <random>
 #include <vector>
 
+#include "solver/cholmod_views.hpp"
 #include "solver/single_factor.hpp"
 
 namespace {
@@ -57,21 +58,7 @@ Csc laplacian3d(int side, double scale = 1.0) {
   return a;
 }
 
-cholmod_sparse view(Csc& a) {
-  cholmod_sparse S{};
-  S.nrow = S.ncol = a.n;
-  S.nzmax = a.i.size();
-  S.p = a.p.data();
-  S.i = a.i.data();
-  S.x = a.x.data();
-  S.stype = 1;
-  S.itype = CHOLMOD_LONG;
-  S.xtype = CHOLMOD_REAL;
-  S.dtype = CHOLMOD_DOUBLE;
-  S.sorted = 1;
-  S.packed = 1;
-  return S;
-}
+cholmod_sparse view(Csc& a) { return bfemp::symmetric_csc_view(a.p, a.i, a.x.data()); }
 
 struct Cholmod {
   cholmod_common c{};
