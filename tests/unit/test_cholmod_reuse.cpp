@@ -500,6 +500,7 @@ TEST(CholmodReuse, TheFloatCopyPreconditionsAsTheDoubleFactorDoes) {
   EXPECT_LE(std::abs(its[1] - its[0]), 1) << its[0] << " (double) against " << its[1] << " (single)";
   answers[1].update(-1.0, answers[0], 1.0);
   EXPECT_LT(answers[1].norm2() / answers[0].norm2(), 1e-10);
+  EXPECT_GT(answers[1].normInf(), 0.0) << "the copy's rounding shows in the last bits: it was applied";
   std::printf("  CG on the previous factor to 1e-12: %d iterations (double factor), %d (float copy)\n", its[0],
               its[1]);
   Fixture f;  // simplicial
