@@ -153,15 +153,18 @@ void deformation_assemble(const DeformationStencils<dim, nv>& s, Kokkos::View<co
       });
 }
 
-// Largest alpha in (0, inf] such that det F_q(x + t p) > 0 for all t < alpha.
+// Largest alpha in (0, inf] such that det F_q(x + t p) > 0 for all t < alpha;
+// inf also when that holds for all t <= cap (a caller that never steps past
+// cap: no stencil's root beyond it is refined, see smallest_positive_det_root).
 template <int dim, int nv>
 double deformation_max_step(const DeformationStencils<dim, nv>& s, Kokkos::View<const double*, MemSpace> x,
-                            Kokkos::View<const double*, MemSpace> p) {
+                            Kokkos::View<const double*, MemSpace> p,
+                            double cap = std::numeric_limits<double>::infinity()) {
   double amin = 0;
   Kokkos::parallel_reduce(
       "deformation_max_step", Kokkos::RangePolicy<ExecSpace>(0, s.size()),
       KOKKOS_LAMBDA(const LO q, double& acc) {
-        const double a = smallest_positive_det_root<dim>(stencil_F(s, x, q), stencil_F(s, p, q));
+        const double a = smallest_positive_det_root<dim>(stencil_F(s, x, q), stencil_F(s, p, q), cap);
         if (a < acc) acc = a;
       },
       Kokkos::Min<double>(amin));

@@ -70,6 +70,27 @@ void interpolate_particles(const ParticleStencils<dim>& ps, Kokkos::View<const d
       kSerialBelow / 16);  // a 20-60 ns body
 }
 
+// The same for the particles of a pair list only: pairs(seg(s), 0) for
+// s < n_seg (the runs of particle_segments below). Pairs sorted by particle
+// (one run per particle) write each particle once; the other particles' xq
+// entries are left as they were.
+template <int dim>
+void interpolate_pair_particles(const ParticleStencils<dim>& ps, const Kokkos::View<LO* [2], MemSpace>& pairs,
+                                const Kokkos::View<LO*, MemSpace>& seg, LO n_seg,
+                                Kokkos::View<const double*, MemSpace> x, Kokkos::View<double*, MemSpace> xq) {
+  small_for(
+      "contact_interpolate_pairs", n_seg,
+      KOKKOS_LAMBDA(const LO s) {
+        const LO q = pairs(seg(s), 0);
+        for (int c = 0; c < dim; ++c) {
+          double v = 0;
+          for (int a = 0; a < ParticleStencils<dim>::ns; ++a) v += ps.w(q, a) * x(ps.nodes(q, a) * dim + c);
+          xq(q * dim + c) = v;
+        }
+      },
+      kSerialBelow / 16);
+}
+
 // Runs of equal particle in a pair list (pairs(k, 0) = particle): seg(s) is
 // the first pair of run s, seg(count) = n; returns count. Pairs sorted by
 // particle (as the broad phase returns them) give one run per particle;

@@ -188,7 +188,8 @@ struct DetPolynomial {
     return lo;
   }
 
-  KOKKOS_INLINE_FUNCTION double smallest_positive_root() const {
+  // cap (> 0, or inf): inf as soon as p is certified positive on [0, cap].
+  KOKKOS_INLINE_FUNCTION double smallest_positive_root(double cap = std::numeric_limits<double>::infinity()) const {
     constexpr double inf = std::numeric_limits<double>::infinity();
     double prev = 0.0, h_prev = certified(0.0);
     if (!(h_prev > 0.0)) return 0.0;  // det T <= 0 up to rounding
@@ -197,14 +198,18 @@ struct DetPolynomial {
     if (n == 0) return inf;
     // p is monotone between critical points: the first right end where
     // positivity is no longer certified brackets the root (or a tangency).
+    // Once cap lies within a monotone piece whose left end is certified
+    // positive, p certified positive at cap too clears [0, cap].
     double x[2];
     const int nx = critical_points(x);
     for (int i = 0; i < nx; ++i) {
+      if (x[i] > cap && certified(cap) > 0.0) return inf;
       const double hx = certified(x[i]);
       if (hx <= 0.0) return refine(prev, h_prev, x[i], hx);
       prev = x[i];
       h_prev = hx;
     }
+    if (cap > prev && cap < inf && certified(cap) > 0.0) return inf;
     // Monotone on (prev, inf): a root exists iff p -> -inf.
     if (c[n] > 0.0) return inf;
     double bound = 0.0;  // Fujiwara: every root has |a| <= bound
@@ -233,8 +238,14 @@ struct DetPolynomial {
 //              times its condition number; at a double/triple root, the start
 //              of the band where det is zero within rounding (generic data:
 //              up to ~sqrt(u) relative for a double root).
+//
+// cap (optional, > 0): +infinity also when det(T + alpha dT) is certified
+// positive for every alpha in [0, cap], whatever lies beyond (a caller that
+// never steps past cap needs no root there; the root's refinement is most of
+// the cost).
 template <int dim>
-KOKKOS_INLINE_FUNCTION double smallest_positive_det_root(const Mat<dim>& T, const Mat<dim>& dT) {
+KOKKOS_INLINE_FUNCTION double smallest_positive_det_root(const Mat<dim>& T, const Mat<dim>& dT,
+                                                         double cap = std::numeric_limits<double>::infinity()) {
   constexpr double inf = std::numeric_limits<double>::infinity();
   const double t_max = T.cwiseAbs().maxCoeff(), d_max = dT.cwiseAbs().maxCoeff();
   if (!T.allFinite() || !dT.allFinite() || t_max == 0.0) return 0.0;
@@ -243,7 +254,7 @@ KOKKOS_INLINE_FUNCTION double smallest_positive_det_root(const Mat<dim>& T, cons
   std::frexp(t_max, &et), std::frexp(d_max, &ed);
   // det(T + a dT) = 2^(dim et) det(Ts + beta dTs) with beta = a 2^(ed - et).
   const det_root_detail::DetPolynomial<dim> p(std::ldexp(1.0, -et) * T, std::ldexp(1.0, -ed) * dT);
-  return std::ldexp(p.smallest_positive_root(), et - ed);
+  return std::ldexp(p.smallest_positive_root(std::ldexp(cap, ed - et)), et - ed);
 }
 
 }  // namespace bfemp

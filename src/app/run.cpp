@@ -153,6 +153,8 @@ void accumulate(RunSummary& s, const StepReport& r) {
   s.contact_broad_phase_s += r.contact_broad_phase_s;
   s.contact_eval_s += r.contact_eval_s;
   s.contact_ccd_s += r.contact_ccd_s;
+  s.contact_searches += r.contact_searches;
+  s.contact_searches_all += r.contact_searches_all;
   s.symbolic_factorizations += r.newton.symbolic_factorizations;
   s.numeric_factorizations += r.newton.numeric_factorizations;
   s.factor_s += r.newton.factor_s;
@@ -450,9 +452,13 @@ RunSummary run_scene(const Scene& scene, const std::string& dir, const Teuchos::
     log << " (" << s.wolfe_steps << " step(s) from the Wolfe bisection, " << s.wolfe_gradients
         << " gradient evaluations)";
   log << "\n";
-  if (s.contact)
+  if (s.contact) {
     log << "  contact: broad phase " << s.contact_broad_phase_s << " s, pair evaluation " << s.contact_eval_s
         << " s, CCD " << s.contact_ccd_s << " s (within the times above)\n";
+    log << "  pair searches       " << s.contact_searches << " among the step's candidate particles, "
+        << s.contact_searches_all << " over all particles (at each step's start, and when the nodes moved "
+        << "beyond the candidates' reach)\n";
+  }
   if (s.sort_every > 0)
     log << "  particle sorts      " << s.particle_sorts << " (by grid cell, every " << s.sort_every << " steps)\n";
   if (s.mpm_ranks > 1)

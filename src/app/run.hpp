@@ -22,6 +22,7 @@ struct RunSummary {
   double assembly_s = 0, solve_s = 0, line_search_s = 0, wall_s = 0;
   bool contact = false;
   double contact_broad_phase_s = 0, contact_eval_s = 0, contact_ccd_s = 0;  // parts of the above
+  long contact_searches = 0, contact_searches_all = 0;  // pair searches; those over every particle
   int frames = 0;
   int checkpoints = 0;
   double output_s = 0;  // frames and checkpoints (the slowest rank)

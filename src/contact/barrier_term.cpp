@@ -38,7 +38,7 @@ struct PairFilter {
   KOKKOS_INLINE_FUNCTION bool operator()(LO q, LO j) const { return contact_allowed<dim>(ps, prims, q, j); }
 };
 
-constexpr double kCcdStepMax = 1.0 / 0.9;  // the solver takes 0.9 of the bound, capped at 1
+constexpr double kCcdStepMax = kStepBoundCap;  // the solver takes 0.9 of the bound, capped at 1
 
 // Adds the seconds of its scope (after a fence) to a counter.
 struct ScopeTimer {
@@ -58,8 +58,15 @@ BarrierTerm<dim>::BarrierTerm(BoundaryPrimitives<dim> prims, double dhat, double
     : prims_(prims), dhat_(dhat), kappa_(kappa), ccd_min_(std::numeric_limits<double>::infinity()) {}
 
 template <int dim>
-void BarrierTerm<dim>::begin_step(const ParticleStencils<dim>& ps, ConstDofView x) {
+void BarrierTerm<dim>::begin_step(const ParticleStencils<dim>& ps, ConstDofView x, const ParticleCells<dim>* cells) {
   ps_ = ps;
+  have_cells_ = cells != nullptr;
+  if (cells) {
+    if (static_cast<LO>(cells->order.extent(0)) > ps.size())
+      throw std::logic_error("BarrierTerm::begin_step: the cells bin more particles than the stencils hold");
+    cells_ = *cells;
+    sums_.reserve(static_cast<LO>(cells->order.extent(0)));
+  }
   const std::size_t n = static_cast<std::size_t>(ps.size()) * dim;
   if (xq_.extent(0) != n) {
     xq_ = Kokkos::View<double*, MemSpace>("contact_xq", n);
@@ -67,7 +74,9 @@ void BarrierTerm<dim>::begin_step(const ParticleStencils<dim>& ps, ConstDofView 
   }
   // The graph's pairs: those within (1 + margin) dhat, a superset of the
   // pairs within dhat (energy, gradient and Hessian skip pairs at d >= dhat).
-  find_pairs(x, ConstDofView(), dhat_ * (1.0 + graph_margin_));
+  // Their particles are the step's first candidates.
+  find_pairs_all(x, ConstDofView(), dhat_ * (1.0 + graph_margin_));
+  keep_candidates(x, dhat_ * (1.0 + graph_margin_));
   // Signature of the couplings: each pair with its particle's stencil base
   // node (the stencil's other nodes follow from it while the MPM cells are
   // unchanged; when they change, the MPM term's version forces a rebuild).
@@ -117,14 +126,21 @@ void BarrierTerm<dim>::begin_step(const ParticleStencils<dim>& ps, ConstDofView 
       KOKKOS_LAMBDA(const LO k) { keys(k) = sig_dev(k, 0); });
 }
 
+// Particle positions (and sweeps) of every particle at x (p), for a search.
 template <int dim>
-void BarrierTerm<dim>::find_pairs(ConstDofView x, ConstDofView p, double pad) const {
-  ScopeTimer timer(timings_.broad_phase_s);
-  const bool moving = p.extent(0) > 0;
+void BarrierTerm<dim>::interpolate_all(ConstDofView x, ConstDofView p) const {
   interpolate_particles(ps_, x, xq_);
-  if (moving) interpolate_particles(ps_, p, dq_);
+  if (p.extent(0) > 0) interpolate_particles(ps_, p, dq_);
+}
+
+template <int dim>
+void BarrierTerm<dim>::find_pairs_all(ConstDofView x, ConstDofView p, double pad, bool interpolated) const {
+  ScopeTimer timer(timings_.broad_phase_s);
+  ++timings_.searches_all;
+  const bool moving = p.extent(0) > 0;
+  if (!interpolated) interpolate_all(x, p);
   point_boxes<dim>(xq_, moving ? ConstDofView(dq_) : ConstDofView(), 0.0, particle_boxes_);
-  simplex_boxes<dim, dim>(prims_.nodes, x, p, pad < 0 ? dhat_ : pad, prim_boxes_);
+  simplex_boxes<dim, dim>(prims_.nodes, x, p, pad, prim_boxes_);
   hash_.build(prim_boxes_);
   if (prims_.size() == 0 || ps_.size() == 0) {
     n_pairs_ = 0;
@@ -133,6 +149,137 @@ void BarrierTerm<dim>::find_pairs(ConstDofView x, ConstDofView p, double pad) co
   } else {  // FEM points too: not against their own body
     n_pairs_ = hash_.query(particle_boxes_, pairs_, PairFilter<dim>{ps_, prims_});
   }
+  find_segments();
+}
+
+// The particles of the pairs just found (xq_ holds every particle at x).
+template <int dim>
+void BarrierTerm<dim>::keep_candidates(ConstDofView x, double reach) const {
+  if (static_cast<LO>(cand_.extent(0)) < n_segments_)  // grows, not per step
+    cand_ = Kokkos::View<LO*, MemSpace>("contact_candidates", n_segments_ + n_segments_ / 4 + 16);
+  if (x_cand_.extent(0) < x.extent(0))  // grows with headroom (the active nodes change from step to step)
+    x_cand_ = Kokkos::View<double*, MemSpace>("contact_candidates_x", x.extent(0) + x.extent(0) / 4 + 16);
+  if (xq_cand_.extent(0) != xq_.extent(0))
+    xq_cand_ = Kokkos::View<double*, MemSpace>("contact_candidates_xq", xq_.extent(0));
+  n_x_cand_ = x.extent(0);
+  const auto cand = cand_;
+  const auto pairs = pairs_;
+  const auto seg = segments_;
+  Kokkos::parallel_for(
+      "contact_candidates", Kokkos::RangePolicy<ExecSpace>(0, n_segments_),
+      KOKKOS_LAMBDA(const LO s) { cand(s) = pairs(seg(s), 0); });  // pairs sorted by particle: ascending
+  n_cand_ = n_segments_;
+  Kokkos::deep_copy(Kokkos::subview(x_cand_, std::make_pair(std::size_t(0), n_x_cand_)), x);
+  Kokkos::deep_copy(xq_cand_, xq_);
+  cand_reach_ = reach;
+}
+
+// With every particle interpolated at x (and p): whether the candidates hold
+// every pair of a search with this pad, by the particles' own displacements
+// since the candidates were found and sweeps, and the primitives' vertices'.
+template <int dim>
+bool BarrierTerm<dim>::candidates_cover(ConstDofView x, ConstDofView p, double pad) const {
+  if (!(cand_reach_ >= 0.0) || n_x_cand_ != x.extent(0) || xq_cand_.extent(0) != xq_.extent(0)) return false;
+  const bool moving = p.extent(0) > 0;
+  const auto xq = xq_, dq = dq_, xqc = xq_cand_, xc = x_cand_;
+  double particles = 0, vertices = 0;  // max over each of displacement + sweep (inf-norm)
+  Kokkos::parallel_reduce(
+      "contact_candidates_particles", Kokkos::RangePolicy<ExecSpace>(0, ps_.size()),
+      KOKKOS_LAMBDA(const LO q, double& acc) {
+        double d = 0, w = 0;
+        for (int c = 0; c < dim; ++c) {
+          d = std::fmax(d, std::fabs(xq(q * dim + c) - xqc(q * dim + c)));
+          if (moving) w = std::fmax(w, std::fabs(dq(q * dim + c)));
+        }
+        acc = std::fmax(acc, d + w);
+      },
+      Kokkos::Max<double>(particles));
+  const auto nodes = prims_.nodes;
+  Kokkos::parallel_reduce(
+      "contact_candidates_vertices", Kokkos::RangePolicy<ExecSpace>(0, prims_.size()),
+      KOKKOS_LAMBDA(const LO j, double& acc) {
+        for (int i = 0; i < dim; ++i) {
+          const LO n = nodes(j, i);
+          if (n < 0) continue;
+          double d = 0, w = 0;
+          for (int c = 0; c < dim; ++c) {
+            d = std::fmax(d, std::fabs(x(n * dim + c) - xc(n * dim + c)));
+            if (moving) w = std::fmax(w, std::fabs(p(n * dim + c)));
+          }
+          acc = std::fmax(acc, d + w);
+        }
+      },
+      Kokkos::Max<double>(vertices));
+  // A relative 1e-12 of the reach for the rounding of boxes. (fmax skips a
+  // NaN; the Newton solver stops on a direction that is not finite before
+  // any search along it.)
+  return particles + vertices <= (cand_reach_ - pad) - 1e-12 * cand_reach_;
+}
+
+// Maps a candidate's index to its particle for the pair filter.
+template <int dim>
+struct CandidateFilter {
+  Kokkos::View<LO*, MemSpace> cand;
+  PairFilter<dim> f;
+  KOKKOS_INLINE_FUNCTION bool operator()(LO c, LO j) const { return f(cand(c), j); }
+};
+
+template <int dim>
+void BarrierTerm<dim>::find_pairs(ConstDofView x, ConstDofView p, double pad_in) const {
+  const double pad = pad_in < 0 ? dhat_ : pad_in;
+  const bool moving = p.extent(0) > 0;
+  ++timings_.searches;
+  {
+    ScopeTimer timer(timings_.broad_phase_s);
+    interpolate_all(x, p);
+  }
+  if (!candidate_search_) {
+    find_pairs_all(x, p, pad, true);
+    return;
+  }
+  bool covered;
+  {
+    ScopeTimer timer(timings_.broad_phase_s);
+    covered = candidates_cover(x, p, pad);
+  }
+  if (!covered) {
+    // New candidates: a search over all particles with this call's sweep and
+    // the primitives padded by reach R > pad. Its particles hold this call's
+    // pairs, and (its boxes holding the positions at x) those of later
+    // searches as the header says.
+    const double reach = pad + dhat_ * std::fmax(graph_margin_, 1.0);
+    find_pairs_all(x, p, reach, true);
+    keep_candidates(x, reach);
+  }
+  ScopeTimer timer(timings_.broad_phase_s);
+  const LO nc = n_cand_;
+  const auto cand = cand_;
+  const auto xq = xq_, dq = dq_;
+  particle_boxes_.resize(nc);
+  const auto lo = particle_boxes_.lo, hi = particle_boxes_.hi;
+  Kokkos::parallel_for(
+      "contact_candidate_boxes", Kokkos::RangePolicy<ExecSpace>(0, nc), KOKKOS_LAMBDA(const LO c) {
+        const LO q = cand(c);
+        for (int d = 0; d < dim; ++d) {
+          const double a = xq(q * dim + d), b = moving ? a + dq(q * dim + d) : a;
+          lo(c, d) = std::fmin(a, b);
+          hi(c, d) = std::fmax(a, b);
+        }
+      });
+  simplex_boxes<dim, dim>(prims_.nodes, x, p, pad, prim_boxes_);
+  hash_.build(prim_boxes_);
+  if (prims_.size() == 0 || nc == 0) {
+    n_pairs_ = 0;
+  } else if (ps_.fem_body_base == INT_MAX) {
+    n_pairs_ = hash_.query(particle_boxes_, pairs_);
+  } else {
+    n_pairs_ = hash_.query(particle_boxes_, pairs_, CandidateFilter<dim>{cand, PairFilter<dim>{ps_, prims_}});
+  }
+  // candidate index -> particle (ascending: the pairs stay sorted by particle, then primitive)
+  const auto pairs = pairs_;
+  Kokkos::parallel_for(
+      "contact_candidate_pairs", Kokkos::RangePolicy<ExecSpace>(0, n_pairs_),
+      KOKKOS_LAMBDA(const LO k) { pairs(k, 0) = cand(pairs(k, 0)); });
   find_segments();
 }
 
@@ -207,7 +354,7 @@ template <int dim>
 double BarrierTerm<dim>::energy(ConstDofView x) const {
   if (n_pairs_ == 0) return 0.0;
   ScopeTimer timer(timings_.evaluation_s);
-  interpolate_particles(ps_, x, xq_);
+  interpolate_pair_particles(ps_, pairs_, segments_, n_segments_, x, xq_);
   const auto pairs = pairs_;
   const auto prims = prims_;
   const auto ps = ps_;
@@ -229,7 +376,7 @@ template <int dim>
 template <class Body>
 void BarrierTerm<dim>::for_each_pair(ConstDofView x, const Body& body) const {
   ScopeTimer timer(timings_.evaluation_s);
-  interpolate_particles(ps_, x, xq_);
+  interpolate_pair_particles(ps_, pairs_, segments_, n_segments_, x, xq_);
   const auto pairs = pairs_;
   const auto prims = prims_;
   const auto ps = ps_;
@@ -270,7 +417,7 @@ void BarrierTerm<dim>::assemble_by_particle(ConstDofView x, const Sink<dim>& sin
   ScopeTimer timer(timings_.evaluation_s);
   Sink<dim> sink = sink_in;
   if (ExecSpace().concurrency() == 1) sink.atomic = false;
-  interpolate_particles(ps_, x, xq_);
+  interpolate_pair_particles(ps_, pairs_, segments_, n_segments_, x, xq_);
   const auto pairs = pairs_;
   const auto seg = segments_;
   const auto prims = prims_;
@@ -281,6 +428,11 @@ void BarrierTerm<dim>::assemble_by_particle(ConstDofView x, const Sink<dim>& sin
   const bool project = project_ && sink.project;
   const double keep = sink.contact_keep;
   constexpr int ns = ParticleStencils<dim>::ns;
+  // With the cells, an assembly's particle sums are expanded cell by cell
+  // after this pass (the gradient alone is cheap enough straight away).
+  const bool by_cell = matrix && have_cells_;
+  const LO n_cell_points = by_cell ? sums_.capacity() : 0;
+  const auto sums = sums_;
   Kokkos::parallel_for(
       "barrier_pairs_by_particle", Kokkos::RangePolicy<ExecSpace>(0, n_segments_), KOKKOS_LAMBDA(const LO s) {
         const LO q = pairs(seg(s), 0);
@@ -329,8 +481,10 @@ void BarrierTerm<dim>::assemble_by_particle(ConstDofView x, const Sink<dim>& sin
           });
         }
         if (!any) return;
-        expand_particle_sums<dim>(ps, q, gp, Hpp, matrix, sink);
+        if (q < n_cell_points) sums.store(q, gp, Hpp);
+        else expand_particle_sums<dim>(ps, q, gp, Hpp, matrix, sink);
       });
+  if (by_cell) expand_by_cell<dim>(cells_, ps_, sums_, true, sink);
 }
 
 template <int dim>
@@ -361,8 +515,8 @@ template <int dim>
 double BarrierTerm<dim>::max_step(ConstDofView x, ConstDofView p) const {
   if (n_pairs_ == 0) return std::numeric_limits<double>::infinity();
   ScopeTimer timer(timings_.ccd_s);
-  interpolate_particles(ps_, x, xq_);
-  interpolate_particles(ps_, p, dq_);
+  interpolate_pair_particles(ps_, pairs_, segments_, n_segments_, x, xq_);
+  interpolate_pair_particles(ps_, pairs_, segments_, n_segments_, p, dq_);
   const auto pairs = pairs_;
   const auto prims = prims_;
   const ConstDofView xq = xq_, dq = dq_;

@@ -7,10 +7,18 @@
 // before each assembly, prepare_direction(x, p) the pairs the segment
 // x + t p (t in [0, 1]) can reach, which serve the CCD step bound (max_step)
 // and the line-search energies. The system graph holds every pair seen in the
-// step; a pair outside it makes update() ask for a rebuild.
+// step; a pair outside it makes update() ask for a rebuild. Those searches
+// query only the step's candidate particles (those near the FEM boundary at
+// the step's start, within the graph's reach) while the particles and the
+// boundary have not moved far enough for others to come near; every
+// particle's position is still interpolated at each search, for that test.
+// Evaluations (energy, gradient, Hessian, CCD) interpolate only the pairs'
+// particles; with MPM cells (begin_step), the Hessian's particle blocks are
+// expanded cell by cell without atomics (particle_expansion.hpp).
 #include <vector>
 
 #include "contact/boundary_primitives.hpp"
+#include "contact/particle_expansion.hpp"
 #include "kernels/contact/broad_phase.hpp"
 #include "kernels/contact/contact_pair.hpp"
 #include "solver/energy_term.hpp"
@@ -24,7 +32,12 @@ class BarrierTerm : public EnergyTerm<dim> {
   std::string name() const override { return "barrier contact"; }
 
   // New step: particle stencils of this step, pairs near x^n (the graph's).
-  void begin_step(const ParticleStencils<dim>& ps, ConstDofView x);
+  // cells (optional): this step's binning of the MPM particles (the first
+  // cells->order.extent(0) points of ps) by cell; with it, assemble() expands
+  // the particles' sums cell by cell, without atomics (particle_expansion.hpp).
+  void begin_step(const ParticleStencils<dim>& ps, ConstDofView x, const ParticleCells<dim>* cells = nullptr);
+  // The binning begin_step was given (null: none).
+  const ParticleCells<dim>* cells() const { return have_cells_ ? &cells_ : nullptr; }
 
   void add_couplings(NodeGraphBuilder& graph) const override;
   // Changes when this step's pairs (with their particles' stencils) differ
@@ -39,6 +52,9 @@ class BarrierTerm : public EnergyTerm<dim> {
   void set_projection(bool project) { project_ = project; }  // false: exact Hessian (tests)
   // begin_step's graph pairs: within (1 + margin) dhat of x^n (default 0).
   void set_graph_margin(double margin) { graph_margin_ = margin; }
+  // false: every pair search over all particles, none among the step's
+  // candidates (tests and timings; the pairs are the same).
+  void set_candidate_search(bool on) { candidate_search_ = on; }
 
   // Pairs (particle, primitive) near x with d < dhat: their distance and the
   // normal force magnitude lambda = -omega c b'(d) (N in 3D, N/m in 2D).
@@ -57,7 +73,10 @@ class BarrierTerm : public EnergyTerm<dim> {
   double take_ccd_min() const;
   // Seconds spent since the last call (resets): broad phase (pair finding and
   // graph checks), pair evaluation (energy, gradient, Hessian), CCD.
-  struct Timings { double broad_phase_s = 0, evaluation_s = 0, ccd_s = 0; };
+  // searches: pair searches over every particle (begin_step's, and new
+  // candidates when the nodes moved too far for the step's), the others
+  // searching this step's candidates only.
+  struct Timings { double broad_phase_s = 0, evaluation_s = 0, ccd_s = 0; long searches = 0, searches_all = 0; };
   Timings take_timings() const;
   const BoundaryPrimitives<dim>& primitives() const { return prims_; }
   const ParticleStencils<dim>& particles() const { return ps_; }
@@ -66,8 +85,29 @@ class BarrierTerm : public EnergyTerm<dim> {
   LO candidate_pairs() const { return n_pairs_; }
 
  private:
-  // Pairs whose boxes (primitives padded by pad, default dhat) overlap; p empty: static.
+  // Pairs whose boxes (primitives padded by pad, default dhat) overlap; p
+  // empty: static. Among this step's candidate particles (below) while they
+  // are sure to hold every such pair, else among all particles after new
+  // candidates are found.
   void find_pairs(ConstDofView x, ConstDofView p, double pad = -1.0) const;
+  void interpolate_all(ConstDofView x, ConstDofView p) const;
+  // The same over every particle (begin_step, and the candidates' search);
+  // interpolated: xq_ (dq_) already hold every particle at x (p).
+  void find_pairs_all(ConstDofView x, ConstDofView p, double pad, bool interpolated = false) const;
+  // Candidates: the particles of the pairs of a search over all particles at
+  // x_c (swept or not) with the primitives padded by reach R. A particle q
+  // outside them has, on some axis, a gap > R between its position x_q(x_c)
+  // and every primitive's box at x_c. If since then the particles moved by
+  // at most D_p (their own positions, interpolated) and the primitives'
+  // vertices by at most D_v, and a search sweeps them by P_p and P_v, the gap
+  // shrinks by at most D_p + P_p + D_v + P_v (each the largest of a
+  // displacement plus a sweep), so a search with pad r needs no particle
+  // outside them while that is <= R - r. Otherwise new candidates are found
+  // by that search itself, over all particles, with R = r + the graph's
+  // margin (at least dhat). Particle displacements, not grid-node ones: a
+  // node that weighs next to nothing may move by kilometres in a direction.
+  void keep_candidates(ConstDofView x, double reach) const;
+  bool candidates_cover(ConstDofView x, ConstDofView p, double pad) const;
   template <class Body>
   void for_each_pair(ConstDofView x, const Body& body) const;
   // Segment starts of the (particle-sorted) pairs: one segment per particle.
@@ -81,9 +121,19 @@ class BarrierTerm : public EnergyTerm<dim> {
   double dhat_, kappa_;
   bool project_ = true;
   double graph_margin_ = 0.0;
+  bool candidate_search_ = true;
   ParticleStencils<dim> ps_;
+  ParticleCells<dim> cells_;
+  bool have_cells_ = false;
+  mutable ParticleSums<dim> sums_;  // assemble()'s per-particle sums (with cells)
   mutable SpatialHash<dim> hash_;
   mutable Boxes<dim> prim_boxes_, particle_boxes_;
+  mutable Kokkos::View<LO*, MemSpace> cand_;       // candidate particles, ascending (capacity grows)
+  mutable LO n_cand_ = 0;
+  mutable Kokkos::View<double*, MemSpace> x_cand_;  // x where they were found (first n_x_cand_ entries)
+  mutable Kokkos::View<double*, MemSpace> xq_cand_;  // every particle's position there
+  mutable std::size_t n_x_cand_ = 0;
+  mutable double cand_reach_ = -1.0;               // their reach R (< 0: none this step)
   mutable Kokkos::View<double*, MemSpace> xq_, dq_;
   mutable Kokkos::View<LO* [2], MemSpace> pairs_;
   mutable LO n_pairs_ = 0;

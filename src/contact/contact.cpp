@@ -240,7 +240,7 @@ void Contact<dim>::begin_step(const MpmBodies<dim>* mpm, ConstDofView x) {
           ps.body(q) = base + body(k);
         });
   }
-  barrier_->begin_step(ps_, x);
+  barrier_->begin_step(ps_, x, mpm ? &mpm->term().cells() : nullptr);
   if (friction_) friction_->clear();
 }
 

@@ -123,8 +123,8 @@ struct FrictionSliding {
 template <int dim>
 FrictionSliding<dim> FrictionTerm<dim>::sliding(ConstDofView x) const {
   const auto& ps = barrier_.particles();
-  interpolate_particles(ps, x, xq_);
-  interpolate_particles(ps, x_ref_, xq_ref_);
+  interpolate_pair_particles(ps, pair_, seg_, n_seg_, x, xq_);  // the lagged pairs' particles only
+  interpolate_pair_particles(ps, pair_, seg_, n_seg_, x_ref_, xq_ref_);
   return {x, xq_, xq_ref_, x_ref_, barrier_.primitives(), pair_, c_, T_, s_};
 }
 
@@ -176,6 +176,12 @@ void FrictionTerm<dim>::assemble_by_particle(ConstDofView x, const Sink<dim>& si
   const double s = s_, eh = eh_;
   const bool matrix = hessian && sink.has_matrix();
   constexpr int ns = ParticleStencils<dim>::ns;
+  // As the barrier term: with the cells, the particle sums are expanded cell by cell.
+  const ParticleCells<dim>* cells = barrier_.cells();
+  const bool by_cell = matrix && cells != nullptr;
+  if (by_cell) sums_.reserve(static_cast<LO>(cells->order.extent(0)));
+  const LO n_cell_points = by_cell ? sums_.capacity() : 0;
+  const auto sums = sums_;
   Kokkos::parallel_for(
       "friction_pairs_by_particle", Kokkos::RangePolicy<ExecSpace>(0, n_seg_), KOKKOS_LAMBDA(const LO r) {
         const LO q = sl.pair(seg(r), 0);
@@ -214,8 +220,10 @@ void FrictionTerm<dim>::assemble_by_particle(ConstDofView x, const Sink<dim>& si
             }
           }
         }
-        expand_particle_sums<dim>(ps, q, gp, Hpp, matrix, sink);
+        if (q < n_cell_points) sums.store(q, gp, Hpp);
+        else expand_particle_sums<dim>(ps, q, gp, Hpp, matrix, sink);
       });
+  if (by_cell) expand_by_cell<dim>(*cells, ps, sums_, true, sink);
 }
 
 template <int dim>

@@ -59,6 +59,7 @@ class FrictionTerm : public EnergyTerm<dim> {
   Kokkos::View<LO*, MemSpace> seg_;  // n_seg_ + 1 starts of each particle's pairs (capacity grows)
   LO n_seg_ = 0;
   mutable Kokkos::View<double*, MemSpace> xq_, xq_ref_;
+  mutable ParticleSums<dim> sums_;  // assemble()'s per-particle sums (with the barrier's cells)
 };
 
 }  // namespace bfemp

@@ -531,6 +531,8 @@ StepReport Simulation<dim>::step() {
     r.contact_broad_phase_s = contact_report.timings.broad_phase_s;
     r.contact_eval_s = contact_report.timings.evaluation_s;
     r.contact_ccd_s = contact_report.timings.ccd_s;
+    r.contact_searches = contact_report.timings.searches;
+    r.contact_searches_all = contact_report.timings.searches_all;
   }
   if (setup_.count_penetrations && mpm_) count_penetrations(r);
   r.step_s = timer.seconds();

@@ -73,6 +73,8 @@ struct StepReport {
   long penetrations_fem = -1, penetrations_level_set = -1;
   double penetration_depth = std::numeric_limits<double>::quiet_NaN();
   double contact_broad_phase_s = 0, contact_eval_s = 0, contact_ccd_s = 0;
+  // pair searches, and those over every particle (BarrierTerm::Timings)
+  long contact_searches = 0, contact_searches_all = 0;
   double step_s = 0;
   std::vector<BodyReport> bodies;  // in the order of Simulation::body_names()
   double total_energy() const { return kinetic + elastic + potential; }

@@ -41,6 +41,12 @@ Sink<dim> make_sink(const LocalMatrix& A, double scale, Kokkos::View<double*, Me
   return s;
 }
 
+// The Newton solver takes a step of at most min(1, 0.9 a_max), a_max the
+// smallest of the terms' max_step bounds: a bound of kStepBoundCap or more
+// gives the full step, like inf.
+constexpr double kStepBoundFraction = 0.9;
+constexpr double kStepBoundCap = 1.0 / kStepBoundFraction;
+
 template <int dim>
 class EnergyTerm {
  public:
@@ -60,7 +66,9 @@ class EnergyTerm {
   // Each stencil's local gradient and PSD Hessian into the sink (which scales
   // them and applies the constraints).
   virtual void assemble(ConstDofView x, const Sink<dim>& sink) const = 0;
-  // Largest step along p keeping the term defined (inf if unbounded).
+  // Largest step along p keeping the term defined (inf if unbounded). A term
+  // may return inf for any bound beyond kStepBoundCap: the Newton solver
+  // steps at most min(1, 0.9 bound), so bounds from 1/0.9 on act alike.
   virtual double max_step(ConstDofView x, ConstDofView p) const = 0;
   // Scatter table (kernels/dof_sink.hpp): the block positions of this term's
   // stencils in A's graph, written into `table` (reallocated only when too
@@ -138,7 +146,9 @@ class DeformationTerm : public EnergyTerm<dim> {
   // false: assemble the exact (unprojected) Hessian, for derivative tests.
   void set_projection(bool project) { project_ = project; }
   bool projection() const { return project_; }
-  double max_step(ConstDofView x, ConstDofView p) const override { return deformation_max_step(s_, x, p); }
+  double max_step(ConstDofView x, ConstDofView p) const override {
+    return deformation_max_step(s_, x, p, kStepBoundCap);
+  }
 
  private:
   std::string name_;

@@ -442,7 +442,7 @@ NewtonStats NewtonSolver<dim>::minimize(const IncrementalPotential& ip, View1 x,
 
     timer.reset();
     double a_max = step_bound();
-    double alpha = std::min(1.0, 0.9 * a_max);
+    double alpha = std::min(1.0, kStepBoundFraction * a_max);
     bool converged = p_inf / ip.dt < eps && pres_left == 0.0;
     if (it == 0) st.first_p_dt = pres_left == 0.0 ? p_inf / ip.dt : std::numeric_limits<double>::infinity();
     if (converged && ls.tolerance > m.solver.tightest_tolerance()) {
@@ -457,7 +457,7 @@ NewtonStats NewtonSolver<dim>::minimize(const IncrementalPotential& ip, View1 x,
       st.solve_s += timer.seconds();
       timer.reset();
       a_max = step_bound();
-      alpha = std::min(1.0, 0.9 * a_max);
+      alpha = std::min(1.0, kStepBoundFraction * a_max);
     }
     if (!project) ++st.exact_hessian_iterations;
     if (kept > 0) ++st.partial_projections;
@@ -555,7 +555,7 @@ NewtonStats NewtonSolver<dim>::minimize(const IncrementalPotential& ip, View1 x,
       std::fprintf(stderr,
                    "  newton %3d  |p|/dt %.3e m/s  step %.3e%s  (bound %.3e)  |rhs| %.3e  %s Hessian%s  linear %d "
                    "it%s%s\n",
-                   it + 1, p_inf / ip.dt, alpha, wolfe_ended ? " (Wolfe)" : "", 0.9 * a_max, r_norm,
+                   it + 1, p_inf / ip.dt, alpha, wolfe_ended ? " (Wolfe)" : "", kStepBoundFraction * a_max, r_norm,
                    project ? "projected" : "exact", kept > 0 ? (" (contact keep " + fmt_g(kept) + ")").c_str() : "",
                    ls.iterations, ls.factorised ? " (factorised)" : "", fallback ? " after a non-positive pivot" : "");
     st.iterations = it + 1;

@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <random>
+#include <tuple>
 
 #include "common/fd_check.hpp"
 #include "contact/contact.hpp"
@@ -281,6 +282,119 @@ TEST(ContactPotentials, FrictionGradientNearCorners2D) {
 TEST(ContactPotentials, FrictionGradientNearCorners3D) {
   friction_gradient_case<3>({Vec<3>(-0.02, -0.03, -0.02), Vec<3>(0.5, -0.03, -0.02)}, 3e-3);
   friction_gradient_case<3>({Vec<3>(-0.02, -0.03, -0.02), Vec<3>(0.5, -0.03, -0.02)}, 5e-2);
+}
+
+// The particles' sums expanded cell by cell (particle_expansion.hpp, the
+// path with MPM cells) against particle by particle (the path without
+// cells): the same gradient, matrix and rhs to round-off, for the barrier
+// and the lagged friction term, with several contact particles per cell
+// (a lattice 3 per cell and axis under the FEM body), some DOFs prescribed
+// and scale != 1.
+template <int dim>
+void by_cell_case() {
+  std::vector<Vec<dim>> pts;
+  for (int i = 0; i < 7; ++i)
+    for (int j = 0; j < (dim == 3 ? 7 : 1); ++j)
+      for (int l = 0; l < 2; ++l) {
+        Vec<dim> p;
+        if constexpr (dim == 2) p << 0.1 + 0.033 * i, -0.015 - 0.033 * l;
+        else p << 0.05 + 0.033 * i, 0.05 + 0.033 * j, -0.015 - 0.033 * l;
+        pts.push_back(p);
+      }
+  auto s = lagged_friction_scene<dim>(pts, 3e-3);
+  ASSERT_FALSE(::testing::Test::HasFailure());
+  auto& barrier = const_cast<BarrierTerm<dim>&>(*s.contact->barrier());
+  const auto& friction = *s.contact->friction();
+  ASSERT_NE(barrier.cells(), nullptr);
+  const std::size_t nd = s.x.extent(0);
+  std::vector<int> mask(nd, 0);
+  fixtures::fd_detail::HostVec dxp(nd, 0.0);
+  for (std::size_t i = 0; i < nd; i += 7) {
+    mask[i] = 1;
+    dxp[i] = 1e-3 * std::sin(1.0 + i);
+  }
+  const auto by_cell_b = fixtures::fd_detail::assemble_dense<dim>(barrier, s.n_nodes, s.x, 2.5, mask, dxp);
+  const auto by_cell_f = fixtures::fd_detail::assemble_dense<dim>(friction, s.n_nodes, s.x, 2.5, mask, dxp);
+  // The same pairs, particle by particle (friction follows the barrier's cells).
+  barrier.begin_step(barrier.particles(), s.x, nullptr);
+  ASSERT_EQ(barrier.cells(), nullptr);
+  const auto direct_b = fixtures::fd_detail::assemble_dense<dim>(barrier, s.n_nodes, s.x, 2.5, mask, dxp);
+  const auto direct_f = fixtures::fd_detail::assemble_dense<dim>(friction, s.n_nodes, s.x, 2.5, mask, dxp);
+  for (const auto& [a, b, name] : {std::tuple{&by_cell_b, &direct_b, "barrier"}, std::tuple{&by_cell_f, &direct_f, "friction"}}) {
+    double amax = 0, gmax = 0, rmax = 0, nonzero = 0;
+    for (double v : b->A) amax = std::max(amax, std::abs(v)), nonzero += v != 0.0;
+    for (double v : b->grad) gmax = std::max(gmax, std::abs(v));
+    for (double v : b->rhs) rmax = std::max(rmax, std::abs(v));
+    ASSERT_GT(rmax, 0.0) << name;
+    ASSERT_GT(nonzero, 100) << name;
+    for (std::size_t i = 0; i < nd; ++i) {
+      EXPECT_NEAR(a->grad[i], b->grad[i], 1e-13 * gmax) << name << " grad " << i;
+      EXPECT_NEAR(a->rhs[i], b->rhs[i], 1e-13 * rmax) << name << " rhs " << i;
+      for (std::size_t j = 0; j < nd; ++j) {
+        EXPECT_NEAR(a->A[i * nd + j], b->A[i * nd + j], 1e-13 * amax) << name << " A(" << i << ", " << j << ")";
+        if (mask[i] || mask[j]) EXPECT_EQ(a->A[i * nd + j], 0.0) << name << " prescribed (" << i << ", " << j << ")";
+      }
+    }
+  }
+}
+
+TEST(ContactPotentials, CellExpansionEqualsParticleExpansion2D) { by_cell_case<2>(); }
+TEST(ContactPotentials, CellExpansionEqualsParticleExpansion3D) { by_cell_case<3>(); }
+
+// Pair searches among the step's candidate particles (those within the
+// graph's reach, (1 + 3) dhat = 0.4, of the FEM body at the step's start)
+// find the same pairs as searches over all particles while the nodes stay
+// within the candidates' reach, and search all particles again when they
+// move beyond it: static searches at iterates that bring particles from
+// 0.15-0.35 above the square into reach, swept searches along directions,
+// the energies and the CCD bounds over the pairs found. Particles 0.6 and
+// more above start outside the candidates and come within dhat only after
+// the large moves (which must search all particles), one of them made by
+// both the particles and the body.
+TEST(ContactPotentials, CandidateSearchesFindTheSamePairsAsSearchesOverAllParticles) {
+  std::vector<Vec<2>> pts;
+  for (int i = 0; i < 9; ++i)
+    for (const double y : {1.03, 1.15, 1.25, 1.35, 1.65, 1.75}) pts.push_back(Vec<2>(0.1 + 0.1 * i, y));
+  auto s = make_scene<2>(pts, params(0.1));
+  auto& cand = const_cast<BarrierTerm<2>&>(*s.contact->barrier());
+  BarrierTerm<2> all(cand.primitives(), cand.dhat(), cand.kappa());
+  all.set_graph_margin(3.0);
+  all.set_candidate_search(false);
+  all.begin_step(cand.particles(), s.x, cand.cells());
+  cand.take_timings();
+  all.take_timings();
+  const LO nF = s.mesh.num_nodes();
+  Kokkos::View<double*, MemSpace> x("x", s.x.extent(0)), p("p", s.x.extent(0));
+  auto check = [&](double down, const char* what, double up = 0.0) {
+    Kokkos::deep_copy(x, s.x);
+    for (LO i = nF; i < s.n_nodes; ++i) x(2 * i + 1) -= down;  // the grid nodes down
+    for (LO i = 0; i < nF; ++i) x(2 * i + 1) += up;            // the square up
+    perturb<2>(x, 2e-3, 21);
+    for (std::size_t i = 0; i < p.extent(0); ++i) p(i) = i >= static_cast<std::size_t>(2 * nF) && i % 2 ? -0.04 : 0.0;
+    cand.update(x);
+    all.update(x);
+    EXPECT_EQ(cand.candidate_pairs(), all.candidate_pairs()) << what;
+    EXPECT_EQ(cand.energy(x), all.energy(x)) << what;
+    cand.prepare_direction(x, p);
+    all.prepare_direction(x, p);
+    EXPECT_EQ(cand.candidate_pairs(), all.candidate_pairs()) << what << " (swept)";
+    EXPECT_EQ(cand.max_step(x, p), all.max_step(x, p)) << what;
+    EXPECT_EQ(cand.energy(x), all.energy(x)) << what << " (swept)";
+  };
+  LO before = 0;
+  check(0.0, "at the start");
+  before = cand.candidate_pairs();
+  check(0.1, "0.1 down");
+  EXPECT_GT(cand.candidate_pairs(), before) << "the move brought no new pairs: the case tests nothing";
+  check(0.08, "0.08 down");
+  EXPECT_EQ(cand.take_timings().searches_all, 0) << "moves within reach searched all particles";
+  // Both sides move, 0.28 each: the particles 0.65 above come within dhat
+  // although neither side moved beyond half the reach (the gap closes by both).
+  check(0.28, "0.28 down, 0.28 up", 0.28);
+  EXPECT_GT(cand.take_timings().searches_all, 0) << "an approach beyond reach kept the step's candidates";
+  check(0.6, "0.6 down");
+  EXPECT_GT(cand.take_timings().searches_all, 0) << "a move beyond reach kept the step's candidates";
+  check(0.61, "0.61 down");
 }
 
 TEST(ContactInitialCheck, RefusesAParticleInsideOrOnTheFemBody) {

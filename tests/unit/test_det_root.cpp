@@ -204,4 +204,43 @@ TYPED_TEST(DetRootTest, RandomAgainstEigenvaluesAndSampling) {
   EXPECT_GT(finite, 50);
 }
 
+// With a cap: the uncapped answer when the root lies below the cap, inf when
+// it lies beyond (certified positive on [0, cap]); never inf for a root the
+// cap covers. Caps near each random root, below and above it, and on the
+// exactly known cases.
+TYPED_TEST(DetRootTest, CapReturnsTheRootBelowItAndInfBeyond) {
+  constexpr int d = TypeParam::value;
+  std::mt19937 rng(16);
+  int below = 0, beyond = 0;
+  for (int t = 0; t < 300; ++t) {
+    Mat<d> T = random_matrix<d>(rng);
+    if (std::abs(T.determinant()) < 1e-2) continue;
+    if (T.determinant() < 0) T.col(0) *= -1.0;
+    const Mat<d> dT = 3.0 * random_matrix<d>(rng);
+    const double root = smallest_positive_det_root<d>(T, dT);
+    for (const double f : {0.5, 0.999, 1.001, 2.0}) {
+      const double cap = std::isfinite(root) ? f * root : f;
+      const double capped = smallest_positive_det_root<d>(T, dT, cap);
+      if (std::isfinite(root) && root <= cap) {
+        EXPECT_EQ(capped, root) << "cap " << cap;
+        ++below;
+      } else {
+        EXPECT_EQ(capped, kInf) << "root " << root << " cap " << cap;
+        ++beyond;
+      }
+    }
+  }
+  EXPECT_GT(below, 100);
+  EXPECT_GT(beyond, 100);
+  const Mat<d> I = Mat<d>::Identity();
+  // (1 + a)(1 - a) (2D) or with a third factor 1: root 1.
+  expect_root(smallest_positive_det_root<d>(I, diag<d>(1, -1, 0), 1.0 / 0.9), 1.0);
+  EXPECT_EQ(smallest_positive_det_root<d>(I, diag<d>(1, -1, 0), 0.9), kInf);
+  // Huge root, small cap; a step along -T reaches 0 at exactly 1.
+  EXPECT_EQ(smallest_positive_det_root<d>(I, -1e-12 * I, 1.0 / 0.9), kInf);
+  expect_root(smallest_positive_det_root<d>(I, -I, 1.0), 1.0);
+  // Already inverted: 0 whatever the cap.
+  EXPECT_EQ(smallest_positive_det_root<d>(diag<d>(-1, 1, 1), I, 1.0), 0.0);
+}
+
 }  // namespace
