@@ -76,7 +76,10 @@ void BarrierTerm<dim>::begin_step(const ParticleStencils<dim>& ps, ConstDofView 
   // pairs within dhat (energy, gradient and Hessian skip pairs at d >= dhat).
   // Their particles are the step's first candidates.
   find_pairs_all(x, ConstDofView(), dhat_ * (1.0 + graph_margin_));
-  keep_candidates(x, dhat_ * (1.0 + graph_margin_));
+  {
+    ScopeTimer timer(timings_.broad_phase_s);
+    keep_candidates(x, dhat_ * (1.0 + graph_margin_));
+  }
   // Signature of the couplings: each pair with its particle's stencil base
   // node (the stencil's other nodes follow from it while the MPM cells are
   // unchanged; when they change, the MPM term's version forces a rebuild).
@@ -199,8 +202,7 @@ bool BarrierTerm<dim>::candidates_cover(ConstDofView x, ConstDofView p, double p
       "contact_candidates_vertices", Kokkos::RangePolicy<ExecSpace>(0, prims_.size()),
       KOKKOS_LAMBDA(const LO j, double& acc) {
         for (int i = 0; i < dim; ++i) {
-          const LO n = nodes(j, i);
-          if (n < 0) continue;
+          const LO n = nodes(j, i);  // a primitive's unused slots repeat its first vertex
           double d = 0, w = 0;
           for (int c = 0; c < dim; ++c) {
             d = std::fmax(d, std::fabs(x(n * dim + c) - xc(n * dim + c)));
@@ -228,7 +230,6 @@ template <int dim>
 void BarrierTerm<dim>::find_pairs(ConstDofView x, ConstDofView p, double pad_in) const {
   const double pad = pad_in < 0 ? dhat_ : pad_in;
   const bool moving = p.extent(0) > 0;
-  ++timings_.searches;
   {
     ScopeTimer timer(timings_.broad_phase_s);
     interpolate_all(x, p);
@@ -249,9 +250,11 @@ void BarrierTerm<dim>::find_pairs(ConstDofView x, ConstDofView p, double pad_in)
     // searches as the header says.
     const double reach = pad + dhat_ * std::fmax(graph_margin_, 1.0);
     find_pairs_all(x, p, reach, true);
+    ScopeTimer timer(timings_.broad_phase_s);
     keep_candidates(x, reach);
   }
   ScopeTimer timer(timings_.broad_phase_s);
+  ++timings_.searches;
   const LO nc = n_cand_;
   const auto cand = cand_;
   const auto xq = xq_, dq = dq_;
@@ -430,7 +433,7 @@ void BarrierTerm<dim>::assemble_by_particle(ConstDofView x, const Sink<dim>& sin
   constexpr int ns = ParticleStencils<dim>::ns;
   // With the cells, an assembly's particle sums are expanded cell by cell
   // after this pass (the gradient alone is cheap enough straight away).
-  const bool by_cell = matrix && have_cells_;
+  const bool by_cell = matrix && cell_expansion();
   const LO n_cell_points = by_cell ? sums_.capacity() : 0;
   const auto sums = sums_;
   Kokkos::parallel_for(

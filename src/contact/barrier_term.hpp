@@ -13,8 +13,8 @@
 // boundary have not moved far enough for others to come near; every
 // particle's position is still interpolated at each search, for that test.
 // Evaluations (energy, gradient, Hessian, CCD) interpolate only the pairs'
-// particles; with MPM cells (begin_step), the Hessian's particle blocks are
-// expanded cell by cell without atomics (particle_expansion.hpp).
+// particles; with MPM cells (begin_step) in 3D, the Hessian's particle
+// blocks are expanded cell by cell without atomics (particle_expansion.hpp).
 #include <vector>
 
 #include "contact/boundary_primitives.hpp"
@@ -33,11 +33,23 @@ class BarrierTerm : public EnergyTerm<dim> {
 
   // New step: particle stencils of this step, pairs near x^n (the graph's).
   // cells (optional): this step's binning of the MPM particles (the first
-  // cells->order.extent(0) points of ps) by cell; with it, assemble() expands
-  // the particles' sums cell by cell, without atomics (particle_expansion.hpp).
+  // cells->order.extent(0) points of ps) by cell; with it (and
+  // set_cell_expansion), assemble() expands the particles' sums cell by
+  // cell, without atomics (particle_expansion.hpp).
   void begin_step(const ParticleStencils<dim>& ps, ConstDofView x, const ParticleCells<dim>* cells = nullptr);
   // The binning begin_step was given (null: none).
   const ParticleCells<dim>* cells() const { return have_cells_ ? &cells_ : nullptr; }
+  // Whether assemble() (and the friction term's) expands the particle blocks
+  // cell by cell when it has the cells; default: in 3D only. In 3D a particle
+  // block reaches 729 3x3 node blocks, and cell by cell halved the contact
+  // assembly of the paper twist at 2 threads (barrier 1.81 -> 1.04 s,
+  // friction 1.47 -> 0.71 s in its first twisting step); in 2D (81 2x2
+  // blocks) the atomic adds cost less than the cell pass: bench_contact at
+  // 1e5 particles and 2 threads, 102 -> 118 ms (barrier), 63 -> 78 ms
+  // (friction); about even at 1 thread. (The tests turn it on in 2D and
+  // compare with begin_step without cells.)
+  void set_cell_expansion(bool on) { cell_expansion_ = on; }
+  bool cell_expansion() const { return cell_expansion_ && have_cells_; }
 
   void add_couplings(NodeGraphBuilder& graph) const override;
   // Changes when this step's pairs (with their particles' stencils) differ
@@ -73,9 +85,10 @@ class BarrierTerm : public EnergyTerm<dim> {
   double take_ccd_min() const;
   // Seconds spent since the last call (resets): broad phase (pair finding and
   // graph checks), pair evaluation (energy, gradient, Hessian), CCD.
-  // searches: pair searches over every particle (begin_step's, and new
-  // candidates when the nodes moved too far for the step's), the others
-  // searching this step's candidates only.
+  // searches: pair searches among the step's candidate particles;
+  // searches_all: those over every particle (begin_step's, new candidates
+  // when the particles or the boundary moved too far for the step's, and
+  // every search with set_candidate_search(false)).
   struct Timings { double broad_phase_s = 0, evaluation_s = 0, ccd_s = 0; long searches = 0, searches_all = 0; };
   Timings take_timings() const;
   const BoundaryPrimitives<dim>& primitives() const { return prims_; }
@@ -122,6 +135,7 @@ class BarrierTerm : public EnergyTerm<dim> {
   bool project_ = true;
   double graph_margin_ = 0.0;
   bool candidate_search_ = true;
+  bool cell_expansion_ = dim == 3;
   ParticleStencils<dim> ps_;
   ParticleCells<dim> cells_;
   bool have_cells_ = false;

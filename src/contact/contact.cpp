@@ -262,7 +262,7 @@ typename Contact<dim>::Report Contact<dim>::report(ConstDofView x, LO n_fem_node
   r.min_distance = act.count > 0 ? dmin : std::numeric_limits<double>::infinity();
   r.barrier_energy = barrier_->energy(x);
   r.ccd_alpha_min = barrier_->take_ccd_min();
-  r.timings = barrier_->take_timings();  // of the solve (the report's own work is not counted)
+  r.timings = barrier_->take_timings();  // of the step (with the report's own pair search and energy above)
   // the system size follows the active grid nodes (it changes most steps): capacity with headroom
   if (grad_.extent(0) < x.extent(0)) grad_ = Kokkos::View<double*, MemSpace>("contact_grad", x.extent(0) + x.extent(0) / 4 + 16);
   const Kokkos::View<double*, MemSpace> gx = Kokkos::subview(grad_, std::make_pair(std::size_t(0), x.extent(0)));

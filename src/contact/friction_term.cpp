@@ -178,7 +178,7 @@ void FrictionTerm<dim>::assemble_by_particle(ConstDofView x, const Sink<dim>& si
   constexpr int ns = ParticleStencils<dim>::ns;
   // As the barrier term: with the cells, the particle sums are expanded cell by cell.
   const ParticleCells<dim>* cells = barrier_.cells();
-  const bool by_cell = matrix && cells != nullptr;
+  const bool by_cell = matrix && barrier_.cell_expansion();
   if (by_cell) sums_.reserve(static_cast<LO>(cells->order.extent(0)));
   const LO n_cell_points = by_cell ? sums_.capacity() : 0;
   const auto sums = sums_;

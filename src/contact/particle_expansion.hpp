@@ -14,7 +14,7 @@
 // - ParticleSums + expand_by_cell: the terms store each particle's (g_p,
 //   H_pp); the particles of one MPM cell (mpm/particle_cells.hpp: the same
 //   3^dim nodes) are summed in a local stencil matrix,
-//     G_a = sum_q w_qa g_q,   H_ab = sum_q w_qa w_qb H_q   (a <= b; H_ba = H_ab^T = H_ab),
+//     G_a = sum_q w_qa g_q,   H_ab = sum_q w_qa w_qb H_q   (a <= b; H_ba = H_ab: scalar weights),
 //   and each cell adds it once, the cells of one color in parallel without
 //   atomics, the particles of a cell in increasing index order (the sums do
 //   not depend on the thread count). The cost per contact particle is the
@@ -141,7 +141,7 @@ void expand_by_cell(const ParticleCells<dim>& pc, const ParticleStencils<dim>& p
             LO prev = -1;
             for (int b = 0; b < ns; ++b) {
               if (W[b] == 0.0) continue;
-              // block (a, b) of the symmetric sum: H_ab for a <= b, else H_ba (= H_ab, each H_q symmetric)
+              // block (a, b): H_ab for a <= b, else H_ba (the same sum: the weights are scalars)
               const int lo = a < b ? a : b, hi = a < b ? b : a;
               const double* blk = H[lo * ns - lo * (lo - 1) / 2 + (hi - lo)];
               const long hint = (pos >= 0 && nodes[b] == prev + 1) ? pos + dim : -1;

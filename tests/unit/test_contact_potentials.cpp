@@ -306,6 +306,9 @@ void by_cell_case() {
   auto& barrier = const_cast<BarrierTerm<dim>&>(*s.contact->barrier());
   const auto& friction = *s.contact->friction();
   ASSERT_NE(barrier.cells(), nullptr);
+  const ParticleCells<dim> cells = *barrier.cells();
+  barrier.set_cell_expansion(true);  // the default in 3D only
+  ASSERT_TRUE(barrier.cell_expansion());
   const std::size_t nd = s.x.extent(0);
   std::vector<int> mask(nd, 0);
   fixtures::fd_detail::HostVec dxp(nd, 0.0);
@@ -318,6 +321,7 @@ void by_cell_case() {
   // The same pairs, particle by particle (friction follows the barrier's cells).
   barrier.begin_step(barrier.particles(), s.x, nullptr);
   ASSERT_EQ(barrier.cells(), nullptr);
+  ASSERT_FALSE(barrier.cell_expansion());
   const auto direct_b = fixtures::fd_detail::assemble_dense<dim>(barrier, s.n_nodes, s.x, 2.5, mask, dxp);
   const auto direct_f = fixtures::fd_detail::assemble_dense<dim>(friction, s.n_nodes, s.x, 2.5, mask, dxp);
   for (const auto& [a, b, name] : {std::tuple{&by_cell_b, &direct_b, "barrier"}, std::tuple{&by_cell_f, &direct_f, "friction"}}) {
@@ -336,6 +340,27 @@ void by_cell_case() {
       }
     }
   }
+  // The barrier, cell by cell at x, then at x2 where the lower row has left
+  // dhat (the grid 0.06 further from the body), against particle by particle
+  // at x2: a mark the first assembly left set would add a stale block.
+  Kokkos::View<double*, MemSpace> x2("x2", nd);
+  Kokkos::deep_copy(x2, s.x);
+  for (LO i = s.mesh.num_nodes(); i < s.n_nodes; ++i) x2(dim * i + dim - 1) -= 0.06;
+  barrier.begin_step(barrier.particles(), s.x, &cells);
+  ASSERT_TRUE(barrier.cell_expansion());
+  barrier.update(s.x);
+  const LO pairs_x = barrier.candidate_pairs();
+  fixtures::fd_detail::assemble_dense<dim>(barrier, s.n_nodes, s.x, 2.5, mask, dxp);
+  barrier.update(x2);
+  ASSERT_LT(barrier.candidate_pairs(), pairs_x) << "no particle left";
+  const auto cell_x2 = fixtures::fd_detail::assemble_dense<dim>(barrier, s.n_nodes, x2, 2.5, mask, dxp);
+  barrier.begin_step(barrier.particles(), x2, nullptr);
+  barrier.update(x2);
+  const auto direct_x2 = fixtures::fd_detail::assemble_dense<dim>(barrier, s.n_nodes, x2, 2.5, mask, dxp);
+  double amax = 0;
+  for (double v : direct_x2.A) amax = std::max(amax, std::abs(v));
+  ASSERT_GT(amax, 0.0);
+  for (std::size_t i = 0; i < nd * nd; ++i) EXPECT_NEAR(cell_x2.A[i], direct_x2.A[i], 1e-13 * amax) << "at x2, entry " << i;
 }
 
 TEST(ContactPotentials, CellExpansionEqualsParticleExpansion2D) { by_cell_case<2>(); }
@@ -365,12 +390,12 @@ TEST(ContactPotentials, CandidateSearchesFindTheSamePairsAsSearchesOverAllPartic
   all.take_timings();
   const LO nF = s.mesh.num_nodes();
   Kokkos::View<double*, MemSpace> x("x", s.x.extent(0)), p("p", s.x.extent(0));
-  auto check = [&](double down, const char* what, double up = 0.0) {
+  auto check = [&](double down, const char* what, double up = 0.0, double sweep = -0.04) {
     Kokkos::deep_copy(x, s.x);
     for (LO i = nF; i < s.n_nodes; ++i) x(2 * i + 1) -= down;  // the grid nodes down
     for (LO i = 0; i < nF; ++i) x(2 * i + 1) += up;            // the square up
     perturb<2>(x, 2e-3, 21);
-    for (std::size_t i = 0; i < p.extent(0); ++i) p(i) = i >= static_cast<std::size_t>(2 * nF) && i % 2 ? -0.04 : 0.0;
+    for (std::size_t i = 0; i < p.extent(0); ++i) p(i) = i >= static_cast<std::size_t>(2 * nF) && i % 2 ? sweep : 0.0;
     cand.update(x);
     all.update(x);
     EXPECT_EQ(cand.candidate_pairs(), all.candidate_pairs()) << what;
@@ -388,6 +413,10 @@ TEST(ContactPotentials, CandidateSearchesFindTheSamePairsAsSearchesOverAllPartic
   EXPECT_GT(cand.candidate_pairs(), before) << "the move brought no new pairs: the case tests nothing";
   check(0.08, "0.08 down");
   EXPECT_EQ(cand.take_timings().searches_all, 0) << "moves within reach searched all particles";
+  // A sweep beyond reach: the particles 0.65 above reach dhat along p only.
+  check(0.1, "0.1 down, swept 0.5 down", 0.0, -0.5);
+  EXPECT_GT(cand.take_timings().searches_all, 0) << "a sweep beyond reach kept the step's candidates";
+  check(0.0, "back at the start");
   // Both sides move, 0.28 each: the particles 0.65 above come within dhat
   // although neither side moved beyond half the reach (the gap closes by both).
   check(0.28, "0.28 down, 0.28 up", 0.28);
