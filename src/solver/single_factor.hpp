@@ -25,8 +25,20 @@
 // Preconditions: the factor is numeric, supernodal and real (assign returns
 // false otherwise and keeps nothing); it is not changed between assign and
 // the solves that use the copy (assign again after each factorisation).
-// solve runs on the calling thread; b and z may be the same array.
+// b and z may be the same array.
+//
+// Threads. solve(b, z, threads) shares the supernodes among `threads` host
+// threads (SupernodeSchedule: disjoint subtrees per thread, the top of the
+// tree by panels; one OpenMP team per solve, outside any Kokkos kernel). Its
+// result differs from the one-thread solve only in the order of the sums into
+// the top's rows (round-off); it is the same from run to run at a given thread
+// count. threads = 0 means Kokkos' host concurrency, on the calling thread
+// alone for a factor under kThreadedEntries stored entries; 1 means the
+// calling thread; more means that many, whatever the size. A factor whose
+// supernodes are not in postorder is solved on the calling thread.
 #include <cholmod.h>
+
+#include "solver/supernode_schedule.hpp"
 
 #include <cstddef>
 #include <vector>
@@ -60,7 +72,10 @@ class SingleFactor {
   bool ready() const { return n_ > 0; }
   void clear();
   // z = P^T L^-T L^-1 P b on the copy. Precondition: ready().
-  void solve(const double* b, double* z);
+  void solve(const double* b, double* z, int threads = 0);
+  static constexpr std::size_t kThreadedEntries = 1 << 20;
+  // The schedule of the last threaded solve (threads == 0 when none).
+  const SupernodeSchedule& schedule() const { return schedule_; }
   std::size_t entries() const { return n_ > 0 ? x_.size() : 0; }  // stored factor entries (L->xsize)
 
  private:
@@ -70,6 +85,19 @@ class SingleFactor {
   std::size_t step_room_ = 0;  // entries this step's copies have made room for (worth_copying)
   std::vector<double> w_;  // the permuted right-hand side, solved in place
   std::vector<double> v_;  // one supernode's rows
+  SuiteSparse_long max_rows_ = 0;
+  SupernodeSchedule schedule_;  // built at the first threaded solve of a copy
+  std::vector<double> vt_;      // per thread: one supernode's rows
+  std::vector<double> buf_;     // per thread: its subtrees' updates of the top's rows
+  std::vector<double> part_;    // per thread: partial dot products of a shared panel
+  int schedule_tried_ = 0;       // the thread count schedule_ was last built for (0: none since the copy)
+  using Long = SuiteSparse_long;
+  void forward_one(std::size_t k, double* w, double* v, Long col_end, double* buf) const;
+  void backward_one(std::size_t k, double* w, double* v) const;
+  void forward_shared(std::size_t k, double* w, double* v, int t, int team) const;
+  void backward_shared(std::size_t k, double* w, double* v, int t, int team);
+  void solve_serial(double* w);
+  void solve_threaded(double* w);
 };
 
 }  // namespace bfemp

@@ -10,6 +10,10 @@
 //  - it differs from CHOLMOD's double solve by the float rounding, no more
 //    (relative 1e-9 .. 1e-4 on this matrix);
 //  - b and z may be one array;
+//  - the solve on 2, 3 and 4 threads (disjoint subtrees per thread, the top
+//    of the tree shared by panels) is the same operator: it gives the
+//    one-thread answer to round-off, the same bits on every call, and is as
+//    exact an inverse of the rounded factor;
 //  - a simplicial factor, a symbolic one, and one whose entries leave float's
 //    range are refused (assign false, nothing kept).
 #include <gtest/gtest.h>
@@ -181,6 +185,41 @@ TEST(SingleFactor, SolvesWithTheFloatRoundedFactorExactlyAndSymmetrically) {
   std::vector<double> inplace = b;
   f.solve(inplace.data(), inplace.data());
   EXPECT_EQ(inplace, z);
+}
+
+TEST(SingleFactor, ThreadedSolveIsTheSameOperatorAsTheSerialOne) {
+  Csc a = laplacian3d(20);
+  Cholmod ch(CHOLMOD_SUPERNODAL);
+  ch.factorise(a);
+  SingleFactor f;
+  ASSERT_TRUE(f.assign(*ch.L));
+  const std::size_t n = a.n;
+  const auto b = random_vector(n, 7);
+  std::vector<double> z1(n);
+  f.solve(b.data(), z1.data(), 1);
+  EXPECT_EQ(f.schedule().threads, 0) << "one thread: no schedule";
+  const auto x = ch.solve(b);
+  const double cholmod_residual = diff(apply_factor(*ch.L, x, false), b);
+  for (int threads : {2, 3, 4}) {
+    std::vector<double> z(n), again(n);
+    f.solve(b.data(), z.data(), threads);
+    const auto& s = f.schedule();
+    ASSERT_EQ(s.threads, threads) << "the factor is in postorder, so the threaded solve ran";
+    EXPECT_GE(s.order.size(), static_cast<std::size_t>(threads)) << "at least one subtree per thread";
+    int shared = 0;
+    for (char c : s.top_shared) shared += c;
+    EXPECT_GT(shared, 0) << "a top supernode solved by the whole team (" << s.top.size() << " in the top)";
+    EXPECT_LT(diff(z, z1), 1e-12 * norm(z1)) << threads << " threads";
+    EXPECT_LT(diff(apply_factor(*ch.L, z), b), 10 * cholmod_residual + 1e-15 * norm(b)) << threads << " threads";
+    f.solve(b.data(), again.data(), threads);
+    EXPECT_EQ(again, z) << "deterministic at " << threads << " threads";
+    std::vector<double> inplace = b;
+    f.solve(inplace.data(), inplace.data(), threads);
+    EXPECT_EQ(inplace, z);
+    std::cout << threads << " threads: " << s.order.size() << " subtrees, " << s.top.size() << " top supernodes ("
+              << shared << " shared), top " << s.top_fraction << " of the entries; |z - z_1| / |z_1| = "
+              << diff(z, z1) / norm(z1) << "\n";
+  }
 }
 
 // worth_copying: a copy into a new buffer after kWorthAfterGrowing solves, into
