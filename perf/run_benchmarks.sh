@@ -3,13 +3,14 @@
 # threads and merges both runs into one JSON with the machine's description.
 # Builds nothing: build first with  ninja -C build bench_newton
 #
-#   perf/run_benchmarks.sh [--bench bench_newton|bench_mpm_newton|bench_ccd|bench_assembly] [--build-dir DIR]
+#   perf/run_benchmarks.sh [--bench bench_newton|bench_mpm_newton|bench_ccd|bench_assembly|bench_explicit|bench_single_factor] [--build-dir DIR]
 #                          [--out FILE] [--threads "1 2"]
 #                          [--wait-quiet SECONDS] [-- options passed to the benchmark]
 #
 # Defaults: --bench bench_newton, --build-dir build, --out build/perf/newton.json
 # (bench_mpm_newton: build/perf/mpm_newton.json; bench_ccd: build/perf/ccd.json),
-# --threads "1 2" (bench_ccd: "1"; it times one query per call, serially).
+# --threads "1 2" (bench_ccd: "1"; it times one query per call, serially;
+# bench_single_factor: "2"; it times 1 thread and OMP_NUM_THREADS itself).
 # --wait-quiet S: before each thread count, wait up to S seconds for the CPUs
 # to be >= 95% idle for 6 s (the machine is shared; see perf/README.md).
 # Compare the result with the stored baseline:
@@ -42,7 +43,8 @@ case "$bench" in
   bench_ccd) bench_json=ccd; bench_name=ccd_queries; [[ -n "$threads" ]] || threads="1" ;;
   bench_assembly) bench_json=assembly; bench_name=assembly ;;
   bench_explicit) bench_json=explicit; bench_name=explicit_step ;;
-  *) echo "run_benchmarks.sh: --bench '$bench': expected bench_newton, bench_mpm_newton, bench_ccd, bench_assembly or bench_explicit" >&2; exit 2 ;;
+  bench_single_factor) bench_json=single_factor; bench_name=single_factor_solve; [[ -n "$threads" ]] || threads="2" ;;
+  *) echo "run_benchmarks.sh: --bench '$bench': expected bench_newton, bench_mpm_newton, bench_ccd, bench_assembly, bench_explicit or bench_single_factor" >&2; exit 2 ;;
 esac
 [[ -n "$threads" ]] || threads="1 2"
 [[ -n "$out" ]] || out="$build_dir/perf/$bench_json.json"
