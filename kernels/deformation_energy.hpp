@@ -108,15 +108,22 @@ KOKKOS_INLINE_FUNCTION void deformation_local_add(const DeformationStencils<dim,
         for (int m = 0; m < dim; ++m) v += D(r, l + dim * m) * gq[b][m];
         DB[r][b * dim + l] = w * v;
       }
-  // Column c = a dim + k of Hl, rows r >= c: sum_j g_aj DB[k + dim j][r].
+  // Column c = a dim + k of Hl, rows r >= c: sum_j g_aj DB[k + dim j][r],
+  // the dim terms summed before the column is loaded, so each entry of Hl is
+  // read and written once per stencil (Hl, 52 KB in 3D, is not in L1).
   for (int a = 0; a < nv; ++a)
     for (int k = 0; k < dim; ++k) {
       const int c = a * dim + k;
       double* col = &Hl(0, c);
-      for (int j = 0; j < dim; ++j) {
-        const double gj = gq[a][j];
-        const double* row = DB[k + dim * j];
-        for (int r = c; r < nd; ++r) col[r] += gj * row[r];
+      const double g0 = gq[a][0], g1 = gq[a][1];
+      const double* r0 = DB[k];
+      const double* r1 = DB[k + dim];
+      if constexpr (dim == 3) {
+        const double g2 = gq[a][2];
+        const double* r2 = DB[k + 2 * dim];
+        for (int r = c; r < nd; ++r) col[r] += g0 * r0[r] + g1 * r1[r] + g2 * r2[r];
+      } else {
+        for (int r = c; r < nd; ++r) col[r] += g0 * r0[r] + g1 * r1[r];
       }
     }
 }

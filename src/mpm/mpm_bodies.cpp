@@ -35,7 +35,6 @@ template <int dim>
 void MpmElasticityTerm<dim>::assemble(ConstDofView x, const Sink<dim>& sink) const {
   constexpr int ns = bspline_stencil_size<dim>;
   constexpr int nd = ns * dim;
-  constexpr int nc = ParticleCells<dim>::n_colors;
   const auto s = this->stencils();
   const bool project = this->projection() && sink.project;
   const auto cells = cells_.cells;
@@ -45,22 +44,29 @@ void MpmElasticityTerm<dim>::assemble(ConstDofView x, const Sink<dim>& sink) con
   if (cells_.order.extent(0) != static_cast<std::size_t>(s.size()))
     throw std::logic_error("MpmElasticityTerm::assemble: particles not binned into cells for these stencils");
   Sink<dim> plain = sink;
-  plain.atomic = false;  // the cells of one color share no node
+  plain.atomic = false;  // the cells of one phase's slabs share no node
   const long n_cells = cells_.n_cells;  // the sink's scatter table, if any, is by cell
-  for (int c = 0; c < nc; ++c) {
-    const LO c0 = cells_.color_start(c), c1 = cells_.color_start(c + 1);
-    if (c1 == c0) continue;
+  const auto sweep = cells_.sweep;
+  const auto phase = cells_.phase;
+  // The sweep (particle_cells.hpp): phase A, then phase B; within a phase the
+  // slabs in parallel, each one's cells in node order on one thread.
+  for (int ph = 0; ph < 2; ++ph) {
     Kokkos::parallel_for(
-        "mpm_assemble_cells", Kokkos::RangePolicy<ExecSpace>(c0, c1), KOKKOS_LAMBDA(const LO k) {
-          const LO n = cells(k);
-          Eigen::Matrix<double, nd, 1> gl = Eigen::Matrix<double, nd, 1>::Zero();
-          SquareMat<nd> Hl = SquareMat<nd>::Zero();
-          const LO first = start(n), last = start(n) + count(n);
-          for (LO i = first; i < last; ++i) deformation_local_add<dim, ns>(s, x, order(i), project, gl, Hl);
-          symmetric_from_lower<nd>(Hl);
-          LO nodes[ns];
-          for (int a = 0; a < ns; ++a) nodes[a] = s.nodes(order(first), a);
-          plain.add_stencil(nodes, ns, gl, &Hl, plain.stencil_positions(k, ns, n_cells));
+        "mpm_assemble_sweep",
+        Kokkos::RangePolicy<ExecSpace, Kokkos::Schedule<Kokkos::Dynamic>>(0, ParticleCells<dim>::kSlabs, Kokkos::ChunkSize(1)),
+        KOKKOS_LAMBDA(const int slab) {
+          for (LO i = phase(4 * slab + 2 * ph); i < phase(4 * slab + 2 * ph + 1); ++i) {
+            const LO k = sweep(i);
+            const LO n = cells(k);
+            Eigen::Matrix<double, nd, 1> gl = Eigen::Matrix<double, nd, 1>::Zero();
+            SquareMat<nd> Hl = SquareMat<nd>::Zero();
+            const LO first = start(n), last = start(n) + count(n);
+            for (LO j = first; j < last; ++j) deformation_local_add<dim, ns>(s, x, order(j), project, gl, Hl);
+            symmetric_from_lower<nd>(Hl);
+            LO nodes[ns];
+            for (int a = 0; a < ns; ++a) nodes[a] = s.nodes(order(first), a);
+            plain.add_stencil(nodes, ns, gl, &Hl, plain.stencil_positions(k, ns, n_cells));
+          }
         });
   }
 }

@@ -8,7 +8,22 @@
 //              some axis, so their supports (3 nodes wide) are disjoint: the
 //              cells of a color can be assembled in parallel without atomics.
 // Within a cell the particles are in increasing index order, so sums over a
-// cell do not depend on the thread count. The occupied set is compared with
+// cell do not depend on the thread count.
+//
+// The sweep (what the MPM elasticity assembly runs): the colors leave no two
+// cells that run one after the other with a node in common, so every cell's
+// 3^dim x 3^dim node blocks are fetched anew from a matrix far larger than
+// the caches. The sweep visits the cells in node order instead (x fastest):
+// consecutive cells share two thirds of their nodes. Its layer is a cell's
+// index along the last axis; the layers are cut into at most kSlabs slabs
+// [b_s, b_s+1) with about equal particle counts, each at least 4 layers thick
+// except the last. Phase A runs, slab by slab in parallel, the layers
+// [b_s + 2, b_s+1) (slab 0 from b_0), phase B then the two layers [b_s,
+// b_s + 2) of slabs s >= 1. A cell spans its layer and the next two, so two
+// cells share a node only if their layers differ by at most 2: phase A's
+// ranges are 3 layers apart, phase B's at least 3 (the slabs are 4 thick),
+// and neither phase needs atomics. The slabs depend on the particles only,
+// so every matrix entry sums its cells in the same order at any thread count. The occupied set is compared with
 // the previous step's: `version` changes only when it does (the MPM part of
 // the Newton graph depends on nothing else).
 // No allocation per step unless the grid grows or the particle count changes.
@@ -35,6 +50,14 @@ struct ParticleCells {
   Kokkos::View<LO[n_colors + 1], Kokkos::HostSpace> color_start;  // host copy (28 ints)
   LO n_cells = 0;
   std::uint64_t version = 0;
+  // The sweep: sweep(i) = k (an index into `cells`), the occupied cells in node
+  // order; slab s runs sweep[phase(4 s), phase(4 s + 1)) in phase A and
+  // sweep[phase(4 s + 2), phase(4 s + 3)) in phase B (device view, set per step).
+  static constexpr int kSlabs = 8;
+  static constexpr int kSlabLayers = 4;
+  Kokkos::View<LO*, MemSpace> sweep;
+  Kokkos::View<LO*, MemSpace> node_rank;  // per grid node: occupied cells before it in node order
+  Kokkos::View<LO[4 * kSlabs], MemSpace> phase;
 };
 
 template <int dim>
@@ -46,6 +69,42 @@ KOKKOS_INLINE_FUNCTION int cell_color(const GridSpec<dim>& grid, LO node) {
     m *= 3;
   }
   return c;
+}
+
+// The sweep's slabs and phase ranges (see above), from the particles before
+// each layer (start of its first node) and the occupied cells before it
+// (node_rank); one device task, a loop over the layers.
+template <int dim>
+void set_sweep_slabs(const GridSpec<dim>& grid, LO np, ParticleCells<dim>& pc) {
+  constexpr int S = ParticleCells<dim>::kSlabs;
+  constexpr int thick = ParticleCells<dim>::kSlabLayers;
+  const LO layers = grid.nodes_along(dim - 1);
+  const LO layer_nodes = grid.num_nodes() / layers;
+  const auto start = pc.start;
+  const auto rank = pc.node_rank;
+  const auto count = pc.count;
+  const auto phase = pc.phase;
+  const LO n_nodes = grid.num_nodes();
+  Kokkos::parallel_for(
+      "mpm_sweep_slabs", Kokkos::RangePolicy<ExecSpace>(0, 1), KOKKOS_LAMBDA(const int) {
+        LO b[S + 1];
+        b[0] = 0;
+        int s = 1;
+        for (LO L = 1; L < layers && s < S; ++L)
+          if (static_cast<long long>(start(L * layer_nodes)) * S >= static_cast<long long>(s) * np &&
+              L - b[s - 1] >= thick)
+            b[s++] = L;
+        for (; s <= S; ++s) b[s] = layers;
+        const LO total = rank(n_nodes - 1) + (count(n_nodes - 1) > 0 ? 1 : 0);
+        auto pos = [&](LO L) { return L >= layers ? total : rank(L * layer_nodes); };
+        for (int t = 0; t < S; ++t) {
+          const LO mid = t == 0 ? b[0] : (b[t] + 2 < b[t + 1] ? b[t] + 2 : b[t + 1]);
+          phase(4 * t) = pos(mid);
+          phase(4 * t + 1) = pos(b[t + 1]);
+          phase(4 * t + 2) = pos(b[t]);
+          phase(4 * t + 3) = pos(mid);
+        }
+      });
 }
 
 // key (optional, one per particle, distinct): the order within a cell is by
@@ -64,10 +123,13 @@ void bin_particles(const GridSpec<dim>& grid, const Particles<dim>& p, ParticleC
     pc.start = Kokkos::View<LO*, MemSpace>("mpm_cell_start", n_nodes);
     pc.occupied_prev = Kokkos::View<LO*, MemSpace>("mpm_cell_occupied_prev", n_nodes);
     pc.cells = Kokkos::View<LO*, MemSpace>("mpm_cells", n_nodes);
+    pc.sweep = Kokkos::View<LO*, MemSpace>("mpm_cell_sweep", n_nodes);
+    pc.node_rank = Kokkos::View<LO*, MemSpace>("mpm_cell_node_rank", n_nodes);
     reshaped = true;
   }
   if (static_cast<LO>(pc.order.extent(0)) != np) pc.order = Kokkos::View<LO*, MemSpace>("mpm_cell_order", np);
   if (pc.color_start_dev.data() == nullptr) {
+    pc.phase = decltype(pc.phase)("mpm_sweep_phase");
     pc.color_start_dev = decltype(pc.color_start_dev)("mpm_color_start");
     pc.color_start = decltype(pc.color_start)("mpm_color_start_host");
     pc.color_cursor = decltype(pc.color_cursor)("mpm_color_cursor");
@@ -104,6 +166,14 @@ void bin_particles(const GridSpec<dim>& grid, const Particles<dim>& p, ParticleC
         if (final) start(n) = offset;
         offset += count(n);
       });
+  auto rank = pc.node_rank;
+  Kokkos::parallel_scan(
+      "mpm_cell_node_rank", Kokkos::RangePolicy<ExecSpace>(0, n_nodes),
+      KOKKOS_LAMBDA(const LO n, LO& offset, const bool final) {
+        if (final) rank(n) = offset;
+        offset += count(n) > 0 ? 1 : 0;
+      });
+  set_sweep_slabs(grid, np, pc);
   Kokkos::deep_copy(pc.color_start, cs);
   for (int c = 0; c < nc; ++c) pc.color_start(c + 1) += pc.color_start(c);
   Kokkos::deep_copy(cs, pc.color_start);
@@ -116,6 +186,7 @@ void bin_particles(const GridSpec<dim>& grid, const Particles<dim>& p, ParticleC
         order(start(b) + Kokkos::atomic_fetch_add(&count(b), 1)) = q;
       });
   auto cursor = pc.color_cursor;
+  auto sweep = pc.sweep;
   Kokkos::deep_copy(cursor, 0);
   Kokkos::parallel_for(
       "mpm_cell_sort", Kokkos::RangePolicy<ExecSpace>(0, n_nodes), KOKKOS_LAMBDA(const LO n) {
@@ -134,7 +205,9 @@ void bin_particles(const GridSpec<dim>& grid, const Particles<dim>& p, ParticleC
           order(j + 1) = v;
         }
         const int c = cell_color(grid, n);
-        cells(cs(c) + Kokkos::atomic_fetch_add(&cursor(c), 1)) = n;
+        const LO slot = cs(c) + Kokkos::atomic_fetch_add(&cursor(c), 1);
+        cells(slot) = n;
+        sweep(rank(n)) = slot;
       });
   if (changed > 0 || reshaped) ++pc.version;
 }

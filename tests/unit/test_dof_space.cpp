@@ -389,6 +389,56 @@ TEST(DofSpace, CellsOfOneColorShareNoNode) {
   for (int q = 0; q < np; ++q) EXPECT_EQ(seen[q], 1) << "particle " << q;
 }
 
+// The sweep (particle_cells.hpp): every occupied cell once, in node order;
+// within a phase, two slabs never share a grid node (what makes the sweep's
+// parallel assembly free of atomics); the slabs hold similar particle counts.
+template <int dim>
+void sweep_case() {
+  GridSpec<dim> grid = grid_covering<dim>(Vec<dim>::Constant(0.0), Vec<dim>::Constant(1.0), 0.04);
+  const int np = dim == 2 ? 6000 : 20000;
+  auto p = allocate_particles<dim>(np);
+  std::mt19937 rng(29);
+  std::uniform_real_distribution<double> pos(0.1, 0.9);
+  for (int q = 0; q < np; ++q)
+    for (int d = 0; d < dim; ++d) p.x(q, d) = d == dim - 1 ? 0.1 + 0.8 * std::pow(pos(rng), 2) : pos(rng);
+  ParticleCells<dim> cells;
+  bin_particles<dim>(grid, p, cells);
+  constexpr int S = ParticleCells<dim>::kSlabs;
+  auto phase = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), cells.phase);
+  std::vector<int> seen(cells.n_cells, 0);
+  int slabs = 0;
+  std::vector<LO> particles_in(S, 0);
+  for (int ph = 0; ph < 2; ++ph) {
+    std::vector<int> owner(grid.num_nodes(), -1);
+    for (int s = 0; s < S; ++s) {
+      if (ph == 0 && phase(4 * s + 1) > phase(4 * s)) ++slabs;
+      for (LO i = phase(4 * s + 2 * ph); i < phase(4 * s + 2 * ph + 1); ++i) {
+        const LO k = cells.sweep(i);
+        ASSERT_GE(k, 0);
+        ASSERT_LT(k, cells.n_cells);
+        ++seen[k];
+        if (i > 0) EXPECT_LT(cells.cells(cells.sweep(i - 1)), cells.cells(k)) << "node order";
+        particles_in[s] += cells.count(cells.cells(k));
+        const GridIndex<dim> b = grid.node_multi_index(cells.cells(k));
+        for (int a = 0; a < bspline_stencil_size<dim>; ++a) {
+          GridIndex<dim> n = b;
+          for (int d = 0, m = a; d < dim; ++d, m /= 3) n[d] += m % 3;
+          int& o = owner[grid.node_index(n)];
+          EXPECT_TRUE(o == -1 || o == s) << "phase " << ph << ": a node of slabs " << o << " and " << s;
+          o = s;
+        }
+      }
+    }
+  }
+  for (LO k = 0; k < cells.n_cells; ++k) EXPECT_EQ(seen[k], 1) << "cell " << k;
+  EXPECT_GE(slabs, S / 2) << "the particles span " << grid.nodes_along(dim - 1) << " layers";
+  for (int s = 0; s < slabs; ++s)  // about np / slabs each (layers are whole)
+    EXPECT_LT(std::abs(particles_in[s] - np / slabs), np / slabs) << "slab " << s;
+}
+
+TEST(DofSpace, SweepSlabsOfOnePhaseShareNoNode2D) { sweep_case<2>(); }
+TEST(DofSpace, SweepSlabsOfOnePhaseShareNoNode3D) { sweep_case<3>(); }
+
 // A block at rest without gravity: the occupied cells never change, so the
 // graph is built once and Cholmod's symbolic phase runs once over 5 steps.
 TEST(DofSpace, UnchangedStructureBuildsTheGraphOnce) {
