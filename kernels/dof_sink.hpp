@@ -36,7 +36,7 @@
 // graph before it is used (add_block_at), so a wrong table costs a search,
 // never a wrong entry. Memory: k^2 ints per stencil (729 per 3D MPM cell).
 //
-// `atomic` = false is for colored assembly, where no two stencils running at
+// `atomic` = false is for colored or swept assembly, where no two stencils running at
 // once share a node. Units: whatever the term's energy has (J, or J/m in 2D).
 #include <Kokkos_Core.hpp>
 #include <cstddef>

@@ -487,7 +487,7 @@ void BarrierTerm<dim>::assemble_by_particle(ConstDofView x, const Sink<dim>& sin
         if (q < n_cell_points) sums.store(q, gp, Hpp);
         else expand_particle_sums<dim>(ps, q, gp, Hpp, matrix, sink);
       });
-  if (by_cell) expand_by_cell<dim>(cells_, ps_, sums_, true, sink);
+  if (by_cell) expand_by_cell<dim>(cells_, ps_, sums_, sink);
 }
 
 template <int dim>

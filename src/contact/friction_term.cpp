@@ -223,7 +223,7 @@ void FrictionTerm<dim>::assemble_by_particle(ConstDofView x, const Sink<dim>& si
         if (q < n_cell_points) sums.store(q, gp, Hpp);
         else expand_particle_sums<dim>(ps, q, gp, Hpp, matrix, sink);
       });
-  if (by_cell) expand_by_cell<dim>(*cells, ps, sums_, true, sink);
+  if (by_cell) expand_by_cell<dim>(*cells, ps, sums_, sink);
 }
 
 template <int dim>

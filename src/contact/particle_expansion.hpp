@@ -78,12 +78,12 @@ struct ParticleSums {
 };
 
 // Adds the stored sums of the marked particles through their stencils (see
-// the top of this file) and clears their marks. cells: the binning of the
+// the top of this file: gradient and matrix) and clears their marks. cells: the binning of the
 // particles ps covers (their first cells.order.extent(0) points); the sink's
 // atomic flag is ignored (the colors make the adds race-free).
 template <int dim, class Sink>
 void expand_by_cell(const ParticleCells<dim>& pc, const ParticleStencils<dim>& ps, const ParticleSums<dim>& sums,
-                    bool matrix, const Sink& sink_in) {
+                    const Sink& sink_in) {
   constexpr int ns = ParticleStencils<dim>::ns;
   constexpr int nc = ParticleCells<dim>::n_colors;
   Sink sink = sink_in;
@@ -116,7 +116,6 @@ void expand_by_cell(const ParticleCells<dim>& pc, const ParticleStencils<dim>& p
               W[a] += w[a];
               for (int c = 0; c < dim; ++c) G[a][c] += w[a] * sums.sum(q, c);
             }
-            if (!matrix) continue;
             double h[dim * dim];
             for (int e = 0; e < dim * dim; ++e) h[e] = sums.sum(q, dim + e);
             int ab = 0;
@@ -136,7 +135,6 @@ void expand_by_cell(const ParticleCells<dim>& pc, const ParticleStencils<dim>& p
           for (int a = 0; a < ns; ++a) {
             if (W[a] == 0.0) continue;
             for (int c = 0; c < dim; ++c) sink.add_gradient(nodes[a], c, G[a][c]);
-            if (!matrix) continue;
             long pos = -1;
             LO prev = -1;
             for (int b = 0; b < ns; ++b) {

@@ -48,25 +48,36 @@ void MpmElasticityTerm<dim>::assemble(ConstDofView x, const Sink<dim>& sink) con
   const long n_cells = cells_.n_cells;  // the sink's scatter table, if any, is by cell
   const auto sweep = cells_.sweep;
   const auto phase = cells_.phase;
+  auto cell_add = KOKKOS_LAMBDA(const LO k) {
+    const LO n = cells(k);
+    Eigen::Matrix<double, nd, 1> gl = Eigen::Matrix<double, nd, 1>::Zero();
+    SquareMat<nd> Hl = SquareMat<nd>::Zero();
+    const LO first = start(n), last = start(n) + count(n);
+    for (LO j = first; j < last; ++j) deformation_local_add<dim, ns>(s, x, order(j), project, gl, Hl);
+    symmetric_from_lower<nd>(Hl);
+    LO nodes[ns];
+    for (int a = 0; a < ns; ++a) nodes[a] = s.nodes(order(first), a);
+    plain.add_stencil(nodes, ns, gl, &Hl, plain.stencil_positions(k, ns, n_cells));
+  };
+  // Too few slabs for the threads (a body thin along the last axis): the
+  // colors, one after the other, the cells of each in parallel.
+  constexpr int kSlabs = ParticleCells<dim>::kSlabs;
+  const int threads = ExecSpace().concurrency();
+  if (threads > 1 && cells_.slabs < std::max(2, std::min(threads, kSlabs) / 2)) {
+    for (int c = 0; c < ParticleCells<dim>::n_colors; ++c) {
+      const LO c0 = cells_.color_start(c), c1 = cells_.color_start(c + 1);
+      if (c1 > c0) Kokkos::parallel_for("mpm_assemble_cells", Kokkos::RangePolicy<ExecSpace>(c0, c1), cell_add);
+    }
+    return;
+  }
   // The sweep (particle_cells.hpp): phase A, then phase B; within a phase the
   // slabs in parallel, each one's cells in node order on one thread.
   for (int ph = 0; ph < 2; ++ph) {
     Kokkos::parallel_for(
         "mpm_assemble_sweep",
-        Kokkos::RangePolicy<ExecSpace, Kokkos::Schedule<Kokkos::Dynamic>>(0, ParticleCells<dim>::kSlabs, Kokkos::ChunkSize(1)),
+        Kokkos::RangePolicy<ExecSpace, Kokkos::Schedule<Kokkos::Dynamic>>(0, kSlabs, Kokkos::ChunkSize(1)),
         KOKKOS_LAMBDA(const int slab) {
-          for (LO i = phase(4 * slab + 2 * ph); i < phase(4 * slab + 2 * ph + 1); ++i) {
-            const LO k = sweep(i);
-            const LO n = cells(k);
-            Eigen::Matrix<double, nd, 1> gl = Eigen::Matrix<double, nd, 1>::Zero();
-            SquareMat<nd> Hl = SquareMat<nd>::Zero();
-            const LO first = start(n), last = start(n) + count(n);
-            for (LO j = first; j < last; ++j) deformation_local_add<dim, ns>(s, x, order(j), project, gl, Hl);
-            symmetric_from_lower<nd>(Hl);
-            LO nodes[ns];
-            for (int a = 0; a < ns; ++a) nodes[a] = s.nodes(order(first), a);
-            plain.add_stencil(nodes, ns, gl, &Hl, plain.stencil_positions(k, ns, n_cells));
-          }
+          for (LO i = phase(4 * slab + 2 * ph); i < phase(4 * slab + 2 * ph + 1); ++i) cell_add(sweep(i));
         });
   }
 }

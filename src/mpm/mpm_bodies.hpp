@@ -55,9 +55,11 @@ struct MpmSetup {
 
 // MPM elasticity: deformation stencils of the particles; the graph couplings
 // come from one particle per distinct stencil (particles in a cell share it).
-// Assembly is by cell and color (mpm/particle_cells.hpp): the particles of a
-// cell sum their local gradient and Hessian in registers, the cell adds them
-// once, and the cells of one color run in parallel without atomics. The
+// Assembly is by cell, in the cells' sweep (mpm/particle_cells.hpp): the
+// particles of a cell sum their local gradient and Hessian in a local stencil
+// matrix, the cell adds it once; the slabs of one phase run in parallel
+// without atomics, each one's cells in node order (consecutive cells share
+// most of their matrix rows, so these stay in the caches). The
 // couplings change only when the set of occupied cells does.
 template <int dim>
 class MpmElasticityTerm : public DeformationTerm<dim, bspline_stencil_size<dim>> {

@@ -16,16 +16,24 @@
 // the caches. The sweep visits the cells in node order instead (x fastest):
 // consecutive cells share two thirds of their nodes. Its layer is a cell's
 // index along the last axis; the layers are cut into at most kSlabs slabs
-// [b_s, b_s+1) with about equal particle counts, each at least 4 layers thick
+// [b_s, b_s+1) with about equal particle counts (each holds an equal share of
+// the particles the slabs before it left), each at least 4 layers thick
 // except the last. Phase A runs, slab by slab in parallel, the layers
 // [b_s + 2, b_s+1) (slab 0 from b_0), phase B then the two layers [b_s,
 // b_s + 2) of slabs s >= 1. A cell spans its layer and the next two, so two
 // cells share a node only if their layers differ by at most 2: phase A's
 // ranges are 3 layers apart, phase B's at least 3 (the slabs are 4 thick),
-// and neither phase needs atomics. The slabs depend on the particles only,
-// so every matrix entry sums its cells in the same order at any thread count. The occupied set is compared with
-// the previous step's: `version` changes only when it does (the MPM part of
-// the Newton graph depends on nothing else).
+// and neither phase needs atomics (every cell's stencil lies inside the grid,
+// as bspline_stencil guarantees). The slabs depend on the particles only, so
+// every matrix entry sums its cells in the same order at any thread count.
+// Limits: at most kSlabs threads work in a phase, and a body thin along the
+// last axis gives few slabs; `slabs` (host) counts those with cells, and
+// MpmElasticityTerm falls back to the colors when they are too few for the
+// threads (then the sums' order depends on the thread count).
+//
+// The occupied set is compared with the previous step's: `version` changes
+// only when it does (the MPM part of the Newton graph depends on nothing
+// else).
 // No allocation per step unless the grid grows or the particle count changes.
 #include <Kokkos_Core.hpp>
 #include <array>
@@ -58,6 +66,8 @@ struct ParticleCells {
   Kokkos::View<LO*, MemSpace> sweep;
   Kokkos::View<LO*, MemSpace> node_rank;  // per grid node: occupied cells before it in node order
   Kokkos::View<LO[4 * kSlabs], MemSpace> phase;
+  Kokkos::View<LO, MemSpace> slabs_dev;
+  LO slabs = 0;  // slabs with cells (host copy)
 };
 
 template <int dim>
@@ -84,16 +94,23 @@ void set_sweep_slabs(const GridSpec<dim>& grid, LO np, ParticleCells<dim>& pc) {
   const auto rank = pc.node_rank;
   const auto count = pc.count;
   const auto phase = pc.phase;
+  const auto slabs = pc.slabs_dev;
   const LO n_nodes = grid.num_nodes();
   Kokkos::parallel_for(
       "mpm_sweep_slabs", Kokkos::RangePolicy<ExecSpace>(0, 1), KOKKOS_LAMBDA(const int) {
+        // Each slab ends at the first layer (at least `thick` on) where it holds
+        // an equal share of the particles not in the slabs before it.
         LO b[S + 1];
         b[0] = 0;
         int s = 1;
-        for (LO L = 1; L < layers && s < S; ++L)
-          if (static_cast<long long>(start(L * layer_nodes)) * S >= static_cast<long long>(s) * np &&
-              L - b[s - 1] >= thick)
+        long long before = 0;  // particles in the slabs before slab s - 1
+        for (LO L = 1; L < layers && s < S; ++L) {
+          const long long upto = start(L * layer_nodes);
+          if ((upto - before) * (S - s + 1) >= static_cast<long long>(np) - before && L - b[s - 1] >= thick) {
             b[s++] = L;
+            before = upto;
+          }
+        }
         for (; s <= S; ++s) b[s] = layers;
         const LO total = rank(n_nodes - 1) + (count(n_nodes - 1) > 0 ? 1 : 0);
         auto pos = [&](LO L) { return L >= layers ? total : rank(L * layer_nodes); };
@@ -104,7 +121,11 @@ void set_sweep_slabs(const GridSpec<dim>& grid, LO np, ParticleCells<dim>& pc) {
           phase(4 * t + 2) = pos(b[t]);
           phase(4 * t + 3) = pos(mid);
         }
+        LO used = 0;
+        for (int t = 0; t < S; ++t) used += pos(b[t + 1]) > pos(b[t]) ? 1 : 0;
+        slabs() = used;
       });
+  Kokkos::deep_copy(pc.slabs, pc.slabs_dev);
 }
 
 // key (optional, one per particle, distinct): the order within a cell is by
@@ -130,6 +151,7 @@ void bin_particles(const GridSpec<dim>& grid, const Particles<dim>& p, ParticleC
   if (static_cast<LO>(pc.order.extent(0)) != np) pc.order = Kokkos::View<LO*, MemSpace>("mpm_cell_order", np);
   if (pc.color_start_dev.data() == nullptr) {
     pc.phase = decltype(pc.phase)("mpm_sweep_phase");
+    pc.slabs_dev = decltype(pc.slabs_dev)("mpm_sweep_slabs");
     pc.color_start_dev = decltype(pc.color_start_dev)("mpm_color_start");
     pc.color_start = decltype(pc.color_start)("mpm_color_start_host");
     pc.color_cursor = decltype(pc.color_cursor)("mpm_color_cursor");

@@ -36,7 +36,6 @@ struct BlockCholmod::Impl {
   bool want_single = false;
   SingleFactor single;  // the factor in float (want_single), copied by prepare_solve() once worth it
   int applies = 0;      // apply() calls since the factorisation
-  bool single_tried = false;  // assign ran on this factor
   double fl = 0, lnz = 0;  // CHOLMOD's analysis: factorisation flops, nonzeros of L
   // Overlap 1 (n_ghost > 0): the ghost rows (imported from their owners into
   // a matrix on ghost_map with a fixed graph), the block's entries from them
@@ -184,7 +183,7 @@ void BlockCholmod::compute() {
   cholmod_sparse S = m.view();
   int status = CHOLMOD_OK;
   m.factored = false;
-  m.single.clear();
+  m.single.forget();
   {
     CholmodSerialScope serial;
     if (!m.analysed && S.nrow > 0) {
@@ -210,7 +209,6 @@ void BlockCholmod::compute() {
     throw SolverError("block Cholesky preconditioner (BLOCK_CHOLMOD): CHOLMOD status " + std::to_string(status) +
                       " on this rank (or a failure on another rank)");
   m.applies = 0;
-  m.single_tried = false;
   m.factored = true;
 }
 
@@ -291,10 +289,7 @@ void BlockCholmod::new_step() { impl_->single.new_step(); }
 
 void BlockCholmod::prepare_solve() {
   auto& m = *impl_;
-  if (m.want_single && m.factored && !m.single_tried && m.p.size() > 1 && m.single.worth_copying(*m.L, m.applies)) {
-    m.single.assign(*m.L);  // (refused: the solves stay in double)
-    m.single_tried = true;
-  }
+  if (m.want_single && m.factored && m.p.size() > 1) m.single.copy_if_worth(*m.L, m.applies);
 }
 
 }  // namespace bfemp

@@ -48,7 +48,6 @@ struct CholmodDirect::Impl {
   bool analysed = false;
   bool factor_ok = false;  // L holds a complete numeric factor of this graph
   SingleFactor single;      // L in float (reuse.single), made once L has served a few CG iterations
-  bool single_tried = false;  // assign ran on this factor (it may have refused it)
   int cg_on_factor = 0;       // CG iterations run on this factor so far
   bool spare_wanted = false;  // a non-positive pivot was met in this step: keep L while refactorising
   Reuse reuse;
@@ -90,8 +89,7 @@ void CholmodDirect::set_matrix(const Teuchos::RCP<const Matrix>& A) {
   if (m.spare) cholmod_l_free_factor(&m.spare, &m.c);
   m.analysed = false;
   m.factor_ok = false;
-  m.single.clear();
-  m.single_tried = false;
+  m.single.forget();
   if (m.reuse.max_iterations > 0 && m.cg_x.extent(0) != n) {
     m.cg_x = Impl::V("cholmod_cg_x", n);
     m.cg_r = Impl::V("cholmod_cg_r", n);
@@ -243,10 +241,7 @@ CholmodDirect::Result CholmodDirect::solve(const Vector& b, Vector& x, double to
     r.max_iterations = m.budget;
     r.tolerance = std::max(r.tolerance, tolerance);
     res.cg_budget = m.budget;
-    if (m.reuse.single && !m.single_tried && m.single.worth_copying(*m.L, m.cg_on_factor)) {
-      m.single.assign(*m.L);
-      m.single_tried = true;
-    }
+    if (m.reuse.single) m.single.copy_if_worth(*m.L, m.cg_on_factor);
     res.cg_single = m.single.ready();
     const bool ok = cg_on_old_factor(r, m.c, m.L, m.single, m.X, m.Y, m.E, *m.A, b, m.cg_x, m.cg_r, m.cg_z, m.cg_p,
                                      m.cg_q, from_x ? &x : nullptr, res.cg_iterations);
@@ -313,8 +308,7 @@ CholmodDirect::Result CholmodDirect::solve(const Vector& b, Vector& x, double to
   }
   if (keep) std::swap(m.L, m.spare);
   m.factor_ok = true;
-  m.single.clear();
-  m.single_tried = false;
+  m.single.forget();
   m.cg_on_factor = 0;
   res.factor_s = factor_timer.seconds();
   auto bv = b.getLocalViewDevice(Tpetra::Access::ReadOnly);

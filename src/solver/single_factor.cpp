@@ -170,21 +170,27 @@ void SingleFactor::backward_shared(std::size_t k, double* w, double* v, int t, i
   auto [lo, hi] = share(0, nsrow, t, team);
   for (Long i = lo; i < hi; ++i) v[i] = i < nscol ? w[k1 + i] : w[s[i]];
 #pragma omp barrier
-  double* part = part_.data() + static_cast<std::size_t>(t) * kPanel;
+  // The rows below a panel in P = schedule_.threads shares whatever the team's
+  // size (share u taken by thread u mod team), summed in share order: the
+  // same bits with a smaller team.
+  const int P = schedule_.threads;
   for (Long p0 = (nscol - 1) / kPanel * kPanel; p0 >= 0; p0 -= kPanel) {
     const Long pe = std::min(p0 + kPanel, nscol);
-    for (Long c = 0; c < pe - p0; ++c) part[c] = 0.0;
-    const auto [ib, ie] = share(pe, nsrow, t, team);
-    Long j = p0;
-    for (; j + supernode::kBlock <= pe; j += supernode::kBlock)
-      supernode::dot_rows<supernode::kBlock>(lk, nsrow, j, v, ib, ie, part + (j - p0));
-    for (; j < pe; ++j) supernode::dot_rows<1>(lk, nsrow, j, v, ib, ie, part + (j - p0));
+    for (int u = t; u < P; u += team) {
+      double* part = part_.data() + static_cast<std::size_t>(u) * kPanel;
+      for (Long c = 0; c < pe - p0; ++c) part[c] = 0.0;
+      const auto [ib, ie] = share(pe, nsrow, u, P);
+      Long j = p0;
+      for (; j + supernode::kBlock <= pe; j += supernode::kBlock)
+        supernode::dot_rows<supernode::kBlock>(lk, nsrow, j, v, ib, ie, part + (j - p0));
+      for (; j < pe; ++j) supernode::dot_rows<1>(lk, nsrow, j, v, ib, ie, part + (j - p0));
+    }
 #pragma omp barrier
     if (t == 0) {
       double acc[kPanel];
       for (Long c = 0; c < pe - p0; ++c) {
         double a = 0.0;
-        for (int q = 0; q < team; ++q) a += part_[static_cast<std::size_t>(q) * kPanel + c];
+        for (int q = 0; q < P; ++q) a += part_[static_cast<std::size_t>(q) * kPanel + c];
         acc[c] = a;
       }
       supernode::backward_columns(lk, nsrow, p0, pe, v, pe, acc);

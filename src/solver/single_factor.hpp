@@ -31,8 +31,9 @@
 // threads (SupernodeSchedule: disjoint subtrees per thread, the top of the
 // tree by panels; one OpenMP team per solve, outside any Kokkos kernel). Its
 // result differs from the one-thread solve only in the order of the sums into
-// the top's rows (round-off); it is the same from run to run at a given thread
-// count. threads = 0 means Kokkos' host concurrency, on the calling thread
+// the top's rows and of the partial dot products of the shared supernodes
+// (round-off); it depends on `threads` alone, not on the size of the team
+// OpenMP actually gives (a smaller team takes the missing threads' shares). threads = 0 means Kokkos' host concurrency, on the calling thread
 // alone for a factor under kThreadedEntries stored entries; 1 means the
 // calling thread; more means that many, whatever the size. A factor whose
 // supernodes are not in postorder is solved on the calling thread.
@@ -65,6 +66,19 @@ class SingleFactor {
     return served >= (L.xsize <= step_room_ ? kWorthAfter : kWorthAfterGrowing);
   }
   void new_step() { step_room_ = 0; }
+  // The copy of the current factor L, made at most once: at the first call
+  // where worth_copying(L, served) holds (later calls do nothing, also after
+  // assign refused L). forget() drops the copy and the attempt, for a new
+  // factor (after each factorisation).
+  void copy_if_worth(const cholmod_factor& L, int served) {
+    if (tried_ || !worth_copying(L, served)) return;
+    assign(L);  // (refused: the solves stay in double)
+    tried_ = true;
+  }
+  void forget() {
+    clear();
+    tried_ = false;
+  }
 
   // Copies L's entries rounded to float (and its pattern). false, and the
   // copy emptied, when L is not a numeric real supernodal factor.
@@ -83,6 +97,7 @@ class SingleFactor {
   std::vector<SuiteSparse_long> perm_, super_, pi_, px_, s_;
   std::vector<float> x_;
   std::size_t step_room_ = 0;  // entries this step's copies have made room for (worth_copying)
+  bool tried_ = false;          // copy_if_worth ran assign on the current factor
   std::vector<double> w_;  // the permuted right-hand side, solved in place
   std::vector<double> v_;  // one supernode's rows
   SuiteSparse_long max_rows_ = 0;

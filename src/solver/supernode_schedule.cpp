@@ -17,6 +17,11 @@ bool SupernodeSchedule::build(int nthreads, std::size_t n, std::size_t ns, const
   std::vector<Long> parent(ns, -1), weight(ns), size(ns, 1), lowest(ns);
   for (std::size_t k = 0; k < ns; ++k) {
     const Long nscol = super[k + 1] - super[k], nsrow = pi[k + 1] - pi[k];
+    for (Long i = 0; i < nsrow; ++i) {  // its columns, then rows below them, ascending
+      const Long r = s[pi[k] + i];
+      if (i < nscol ? r != super[k] + i : (r < super[k + 1] || (i > 0 && r <= s[pi[k] + i - 1])) || r >= static_cast<Long>(n))
+        return false;
+    }
     weight[k] = nscol * nsrow;
     lowest[k] = static_cast<Long>(k);
     if (nsrow > nscol) {

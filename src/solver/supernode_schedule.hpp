@@ -22,8 +22,8 @@
 //
 // Preconditions: CHOLMOD's supernodes in postorder (each subtree a contiguous
 // range of supernodes and columns, a parent numbered after its children;
-// CHOLMOD's default); build() returns false otherwise and the solve stays on
-// one thread. The schedule depends only on the pattern and the thread count,
+// CHOLMOD's default), and each supernode's rows ascending, its own columns
+// first; build() returns false otherwise and the solve stays on one thread. The schedule depends only on the pattern and the thread count,
 // so a solve is deterministic for a given thread count.
 #include <cholmod.h>
 
@@ -52,7 +52,7 @@ struct SupernodeSchedule {
   double top_fraction = 0;        // the top's share of the stored entries (the part not in subtrees)
 
   // Builds the schedule for `threads` threads from the factor's supernodal
-  // pattern (super, pi, px, s as CHOLMOD stores them, ns supernodes, n columns).
+  // pattern (super, pi, s as CHOLMOD stores them, ns supernodes, n columns).
   bool build(int threads, std::size_t n, std::size_t ns, const Long* super, const Long* pi, const Long* s);
   void clear() {
     threads = 0;

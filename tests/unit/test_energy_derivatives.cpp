@@ -111,7 +111,7 @@ void mpm_case(bool compressed = false) {
     for (int c = 0; c < dim; ++c) x(k * dim + c) = xi(c) + disp(rng);
   }
   MpmElasticityTerm<dim> term("mpm", s);
-  ParticleCells<dim> cells;  // the colored, per-cell assembly
+  ParticleCells<dim> cells;  // the per-cell assembly (the sweep)
   bin_particles<dim>(grid, p, cells);
   term.set_cells(cells);
   check_term(term, n, x, 1e-7, 1e-5);

@@ -12,13 +12,15 @@
 //  - b and z may be one array;
 //  - the solve on 2, 3 and 4 threads (disjoint subtrees per thread, the top
 //    of the tree shared by panels) is the same operator: it gives the
-//    one-thread answer to round-off, the same bits on every call, and is as
-//    exact an inverse of the rounded factor;
+//    one-thread answer to round-off, the same bits on every call and with a
+//    team of one thread, and is as exact an inverse of the rounded factor;
 //  - a simplicial factor, a symbolic one, and one whose entries leave float's
 //    range are refused (assign false, nothing kept).
 #include <gtest/gtest.h>
 
 #include <cholmod.h>
+#include <omp.h>
+
 #include <cmath>
 #include <random>
 #include <vector>
@@ -216,6 +218,18 @@ TEST(SingleFactor, ThreadedSolveIsTheSameOperatorAsTheSerialOne) {
     std::vector<double> inplace = b;
     f.solve(inplace.data(), inplace.data(), threads);
     EXPECT_EQ(inplace, z);
+    {  // inside a parallel region without nested parallelism OpenMP gives a team of 1: the same bits
+      std::vector<double> nested(n);
+      const int levels = omp_get_max_active_levels();
+      omp_set_max_active_levels(1);
+#pragma omp parallel num_threads(2)
+      {
+#pragma omp single
+        f.solve(b.data(), nested.data(), threads);
+      }
+      omp_set_max_active_levels(levels);
+      EXPECT_EQ(nested, z) << "a team of 1 for " << threads << " threads' schedule";
+    }
     std::cout << threads << " threads: " << s.order.size() << " subtrees, " << s.top.size() << " top supernodes ("
               << shared << " shared), top " << s.top_fraction << " of the entries; |z - z_1| / |z_1| = "
               << diff(z, z1) / norm(z1) << "\n";
