@@ -86,7 +86,7 @@ std::string bench(long n_particles, long n_facets) {
   cp.mu = {0.5};
   Contact<2> contact(mesh, cp);
   contact.begin_step(mpm, x);
-  const auto* barrier = contact.barrier();
+  auto* barrier = contact.barrier();
   const double t_broad = best_time([&] { barrier->update(x); });
   const LO candidates = barrier->candidate_pairs();
   const LO active = barrier->active_pairs(x).count;

@@ -131,13 +131,13 @@ void BarrierTerm<dim>::begin_step(const ParticleStencils<dim>& ps, ConstDofView 
 
 // Particle positions (and sweeps) of every particle at x (p), for a search.
 template <int dim>
-void BarrierTerm<dim>::interpolate_all(ConstDofView x, ConstDofView p) const {
+void BarrierTerm<dim>::interpolate_all(ConstDofView x, ConstDofView p) {
   interpolate_particles(ps_, x, xq_);
   if (p.extent(0) > 0) interpolate_particles(ps_, p, dq_);
 }
 
 template <int dim>
-void BarrierTerm<dim>::find_pairs_all(ConstDofView x, ConstDofView p, double pad, bool interpolated) const {
+void BarrierTerm<dim>::find_pairs_all(ConstDofView x, ConstDofView p, double pad, bool interpolated) {
   ScopeTimer timer(timings_.broad_phase_s);
   ++timings_.searches_all;
   const bool moving = p.extent(0) > 0;
@@ -157,7 +157,7 @@ void BarrierTerm<dim>::find_pairs_all(ConstDofView x, ConstDofView p, double pad
 
 // The particles of the pairs just found (xq_ holds every particle at x).
 template <int dim>
-void BarrierTerm<dim>::keep_candidates(ConstDofView x, double reach) const {
+void BarrierTerm<dim>::keep_candidates(ConstDofView x, double reach) {
   if (static_cast<LO>(cand_.extent(0)) < n_segments_)  // grows, not per step
     cand_ = Kokkos::View<LO*, MemSpace>("contact_candidates", n_segments_ + n_segments_ / 4 + 16);
   if (x_cand_.extent(0) < x.extent(0))  // grows with headroom (the active nodes change from step to step)
@@ -227,7 +227,7 @@ struct CandidateFilter {
 };
 
 template <int dim>
-void BarrierTerm<dim>::find_pairs(ConstDofView x, ConstDofView p, double pad_in) const {
+void BarrierTerm<dim>::find_pairs(ConstDofView x, ConstDofView p, double pad_in) {
   const double pad = pad_in < 0 ? dhat_ : pad_in;
   const bool moving = p.extent(0) > 0;
   {
@@ -287,12 +287,12 @@ void BarrierTerm<dim>::find_pairs(ConstDofView x, ConstDofView p, double pad_in)
 }
 
 template <int dim>
-void BarrierTerm<dim>::find_segments() const {
+void BarrierTerm<dim>::find_segments() {
   n_segments_ = particle_segments(pairs_, n_pairs_, segments_);
 }
 
 template <int dim>
-bool BarrierTerm<dim>::update(ConstDofView x) const {
+bool BarrierTerm<dim>::update(ConstDofView x) {
   find_pairs(x, ConstDofView());
   ScopeTimer timer(timings_.broad_phase_s);
   const auto keys = graph_keys_dev_;
@@ -340,7 +340,7 @@ bool BarrierTerm<dim>::update(ConstDofView x) const {
 }
 
 template <int dim>
-void BarrierTerm<dim>::prepare_direction(ConstDofView x, ConstDofView p) const {
+void BarrierTerm<dim>::prepare_direction(ConstDofView x, ConstDofView p) {
   find_pairs(x, p);
 }
 
@@ -547,21 +547,21 @@ double BarrierTerm<dim>::max_step(ConstDofView x, ConstDofView p) const {
 }
 
 template <int dim>
-typename BarrierTerm<dim>::Timings BarrierTerm<dim>::take_timings() const {
+typename BarrierTerm<dim>::Timings BarrierTerm<dim>::take_timings() {
   const Timings t = timings_;
   timings_ = Timings{};
   return t;
 }
 
 template <int dim>
-double BarrierTerm<dim>::take_ccd_min() const {
+double BarrierTerm<dim>::take_ccd_min() {
   const double t = ccd_min_;
   ccd_min_ = std::numeric_limits<double>::infinity();
   return t;
 }
 
 template <int dim>
-typename BarrierTerm<dim>::ActivePairs BarrierTerm<dim>::active_pairs(ConstDofView x) const {
+typename BarrierTerm<dim>::ActivePairs BarrierTerm<dim>::active_pairs(ConstDofView x) {
   find_pairs(x, ConstDofView());
   ActivePairs out;
   // Buffers grow and are kept (not per call): capacity >= count.

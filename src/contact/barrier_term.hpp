@@ -59,8 +59,8 @@ class BarrierTerm : public EnergyTerm<dim> {
   void gradient(ConstDofView x, double scale, DofView grad) const override;
   void assemble(ConstDofView x, const Sink<dim>& sink) const override;
   double max_step(ConstDofView x, ConstDofView p) const override;
-  bool update(ConstDofView x) const override;
-  void prepare_direction(ConstDofView x, ConstDofView p) const override;
+  bool update(ConstDofView x) override;
+  void prepare_direction(ConstDofView x, ConstDofView p) override;
   void set_projection(bool project) { project_ = project; }  // false: exact Hessian (tests)
   // begin_step's graph pairs: within (1 + margin) dhat of x^n (default 0).
   void set_graph_margin(double margin) { graph_margin_ = margin; }
@@ -77,12 +77,12 @@ class BarrierTerm : public EnergyTerm<dim> {
     Kokkos::View<double*, MemSpace> distance, lambda;
     LO count = 0;
   };
-  ActivePairs active_pairs(ConstDofView x) const;
+  ActivePairs active_pairs(ConstDofView x);
   // Contact force on the particles (-dB/dx_q), node-interleaved per particle.
   void particle_forces(ConstDofView x, DofView f) const;
 
   // Smallest CCD bound returned since the last call (inf if none); resets.
-  double take_ccd_min() const;
+  double take_ccd_min();
   // Seconds spent since the last call (resets): broad phase (pair finding and
   // graph checks), pair evaluation (energy, gradient, Hessian), CCD.
   // searches: pair searches among the step's candidate particles;
@@ -90,7 +90,7 @@ class BarrierTerm : public EnergyTerm<dim> {
   // when the particles or the boundary moved too far for the step's, and
   // every search with set_candidate_search(false)).
   struct Timings { double broad_phase_s = 0, evaluation_s = 0, ccd_s = 0; long searches = 0, searches_all = 0; };
-  Timings take_timings() const;
+  Timings take_timings();
   const BoundaryPrimitives<dim>& primitives() const { return prims_; }
   const ParticleStencils<dim>& particles() const { return ps_; }
   double dhat() const { return dhat_; }
@@ -102,11 +102,11 @@ class BarrierTerm : public EnergyTerm<dim> {
   // empty: static. Among this step's candidate particles (below) while they
   // are sure to hold every such pair, else among all particles after new
   // candidates are found.
-  void find_pairs(ConstDofView x, ConstDofView p, double pad = -1.0) const;
-  void interpolate_all(ConstDofView x, ConstDofView p) const;
+  void find_pairs(ConstDofView x, ConstDofView p, double pad = -1.0);
+  void interpolate_all(ConstDofView x, ConstDofView p);
   // The same over every particle (begin_step, and the candidates' search);
   // interpolated: xq_ (dq_) already hold every particle at x (p).
-  void find_pairs_all(ConstDofView x, ConstDofView p, double pad, bool interpolated = false) const;
+  void find_pairs_all(ConstDofView x, ConstDofView p, double pad, bool interpolated = false);
   // Candidates: the particles of the pairs of a search over all particles at
   // x_c (swept or not) with the primitives padded by reach R. A particle q
   // outside them has, on some axis, a gap > R between its position x_q(x_c)
@@ -119,12 +119,12 @@ class BarrierTerm : public EnergyTerm<dim> {
   // by that search itself, over all particles, with R = r + the graph's
   // margin (at least dhat). Particle displacements, not grid-node ones: a
   // node that weighs next to nothing may move by kilometres in a direction.
-  void keep_candidates(ConstDofView x, double reach) const;
+  void keep_candidates(ConstDofView x, double reach);
   bool candidates_cover(ConstDofView x, ConstDofView p, double pad) const;
   template <class Body>
   void for_each_pair(ConstDofView x, const Body& body) const;
   // Segment starts of the (particle-sorted) pairs: one segment per particle.
-  void find_segments() const;
+  void find_segments();
   // Gradient (and with hessian the PSD-projected Hessian) of every pair, one
   // particle's pairs at a time: their particle blocks are summed first and
   // expanded through the particle's stencil once.
@@ -139,29 +139,37 @@ class BarrierTerm : public EnergyTerm<dim> {
   ParticleStencils<dim> ps_;
   ParticleCells<dim> cells_;
   bool have_cells_ = false;
-  mutable ParticleSums<dim> sums_;  // assemble()'s per-particle sums (with cells)
-  mutable SpatialHash<dim> hash_;
-  mutable Boxes<dim> prim_boxes_, particle_boxes_;
-  mutable Kokkos::View<LO*, MemSpace> cand_;       // candidate particles, ascending (capacity grows)
-  mutable LO n_cand_ = 0;
-  mutable Kokkos::View<double*, MemSpace> x_cand_;  // x where they were found (first n_x_cand_ entries)
-  mutable Kokkos::View<double*, MemSpace> xq_cand_;  // every particle's position there
-  mutable std::size_t n_x_cand_ = 0;
-  mutable double cand_reach_ = -1.0;               // their reach R (< 0: none this step)
-  mutable Kokkos::View<double*, MemSpace> xq_, dq_;
-  mutable Kokkos::View<LO* [2], MemSpace> pairs_;
-  mutable LO n_pairs_ = 0;
-  mutable Kokkos::View<LO*, MemSpace> segments_;  // n_segments_ + 1 starts into pairs_ (capacity grows)
-  mutable LO n_segments_ = 0;
-  mutable Kokkos::View<long long*, MemSpace> graph_keys_dev_;  // the graph's pairs: q * n_prims + j, sorted
+  // State: the pair set and what its searches keep, changed only by
+  // begin_step, update, prepare_direction and active_pairs.
+  SpatialHash<dim> hash_;
+  Boxes<dim> prim_boxes_, particle_boxes_;
+  Kokkos::View<LO*, MemSpace> cand_;       // candidate particles, ascending (capacity grows)
+  LO n_cand_ = 0;
+  Kokkos::View<double*, MemSpace> x_cand_;  // x where they were found (first n_x_cand_ entries)
+  Kokkos::View<double*, MemSpace> xq_cand_;  // every particle's position there
+  std::size_t n_x_cand_ = 0;
+  double cand_reach_ = -1.0;               // their reach R (< 0: none this step)
+  Kokkos::View<LO* [2], MemSpace> pairs_;
+  LO n_pairs_ = 0;
+  Kokkos::View<LO*, MemSpace> segments_;  // n_segments_ + 1 starts into pairs_ (capacity grows)
+  LO n_segments_ = 0;
+  Kokkos::View<long long*, MemSpace> graph_keys_dev_;  // the graph's pairs: q * n_prims + j, sorted
   // (pair key, stencil base) of each begin_step pair, in the broad phase's
   // (sorted) order: this step's, and those the graph was last asked for.
   Kokkos::View<long long* [2], MemSpace> signature_dev_, graph_signature_;
   LO n_signature_ = 0;
-  mutable Kokkos::View<double*, MemSpace> pair_distance_;
-  mutable std::uint64_t version_ = 0;
-  mutable bool grown_ = false;  // update() added pairs in this step
-  mutable ActivePairs active_;  // buffers of active_pairs()
+  Kokkos::View<double*, MemSpace> pair_distance_;
+  std::uint64_t version_ = 0;
+  bool grown_ = false;  // update() added pairs in this step
+  ActivePairs active_;  // buffers of active_pairs()
+  // Scratch of the evaluations (energy, gradient, assemble, max_step) and the
+  // searches: positions (and sweeps) of the particles at the call's x (p),
+  // and the particles' summed blocks. Kept for their capacity only: every
+  // call writes what it reads first, so nothing passes from one call to the
+  // next.
+  mutable Kokkos::View<double*, MemSpace> xq_, dq_;
+  mutable ParticleSums<dim> sums_;
+  // Statistics for the step's report, never read by a computation.
   mutable double ccd_min_;
   mutable Timings timings_;
 };

@@ -70,7 +70,9 @@ class Contact {
   // order they follow the particles), and their count.
   LO num_fem_points() const { return static_cast<LO>(fem_point_node_.extent(0)); }
   const BarrierTerm<dim>* barrier() const { return barrier_.get(); }
+  BarrierTerm<dim>* barrier() { return barrier_.get(); }  // (the Newton solver updates its pairs)
   const FrictionTerm<dim>* friction() const { return friction_.get(); }
+  FrictionTerm<dim>* friction() { return friction_.get(); }
   bool has_friction() const { return friction_ != nullptr; }
   // Re-lags friction at x (see FrictionTerm); returns the pairs with friction.
   LO update_friction(ConstDofView x, ConstDofView x_ref, double s, double dt);
@@ -107,6 +109,8 @@ class Contact {
   std::unique_ptr<FrictionTerm<dim>> friction_;
   ParticleStencils<dim> ps_;
   Kokkos::View<double*, MemSpace> grad_, particle_force_, report_xp_;
+  // Scratch of the const inside-checks (check_initial, particle_inside,
+  // count_inside): buffers kept for their capacity; no value outlives a call.
   mutable SpatialHash<dim> element_hash_;
   mutable Boxes<dim> element_boxes_, point_boxes_;
   mutable Kokkos::View<LO* [2], MemSpace> inside_pairs_;

@@ -10,7 +10,7 @@
 namespace bfemp {
 
 template <int dim>
-FrictionTerm<dim>::FrictionTerm(const BarrierTerm<dim>& barrier, std::vector<double> mu, int n_fem_bodies,
+FrictionTerm<dim>::FrictionTerm(BarrierTerm<dim>& barrier, std::vector<double> mu, int n_fem_bodies,
                                 double eps_v)
     : barrier_(barrier), n_fem_(n_fem_bodies), eps_v_(eps_v) {
   mu_ = Kokkos::View<double*, MemSpace>("friction_mu", mu.size());

@@ -22,11 +22,12 @@ template <int dim>
 class FrictionTerm : public EnergyTerm<dim> {
  public:
   // mu(mpm body, fem body) as a row-major table [n_mpm x n_fem].
-  FrictionTerm(const BarrierTerm<dim>& barrier, std::vector<double> mu, int n_fem_bodies, double eps_v);
+  FrictionTerm(BarrierTerm<dim>& barrier, std::vector<double> mu, int n_fem_bodies, double eps_v);
   std::string name() const override { return "friction"; }
 
-  // Lags lambda, T, c at x from the barrier's active pairs; x_ref, s as above.
-  // Returns the number of pairs with mu lambda != 0.
+  // Lags lambda, T, c at x from the barrier's active pairs (which moves the
+  // barrier's pair set to x); x_ref, s as above. Returns the number of pairs
+  // with mu lambda != 0.
   LO update_lagged(ConstDofView x, ConstDofView x_ref, double s, double dt);
   void clear() { n_ = 0; }
   LO pairs() const { return n_; }
@@ -45,7 +46,7 @@ class FrictionTerm : public EnergyTerm<dim> {
   void assemble_by_particle(ConstDofView x, const Sink<dim>& sink, bool hessian) const;
   FrictionSliding<dim> sliding(ConstDofView x) const;
 
-  const BarrierTerm<dim>& barrier_;
+  BarrierTerm<dim>& barrier_;
   Kokkos::View<double*, MemSpace> mu_;  // [n_mpm * n_fem]
   int n_fem_;
   double eps_v_;
@@ -58,8 +59,11 @@ class FrictionTerm : public EnergyTerm<dim> {
   LO n_ = 0;
   Kokkos::View<LO*, MemSpace> seg_;  // n_seg_ + 1 starts of each particle's pairs (capacity grows)
   LO n_seg_ = 0;
+  // Scratch of the evaluations (kept for its capacity; every call writes
+  // what it reads): the pairs' particles at x and x_ref, and assemble()'s
+  // per-particle sums (with the barrier's cells).
   mutable Kokkos::View<double*, MemSpace> xq_, xq_ref_;
-  mutable ParticleSums<dim> sums_;  // assemble()'s per-particle sums (with the barrier's cells)
+  mutable ParticleSums<dim> sums_;
 };
 
 }  // namespace bfemp

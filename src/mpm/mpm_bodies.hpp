@@ -115,6 +115,7 @@ class MpmBodies {
                 Kokkos::View<const double*, MemSpace> v_old);
 
   const MpmElasticityTerm<dim>& term() const { return *term_; }
+  MpmElasticityTerm<dim>& term() { return *term_; }  // (the Newton solver's term list)
   // This rank's particles (all of them on one rank).
   const Particles<dim>& particles() const { return setup_.particles; }
 

@@ -361,7 +361,7 @@ StepReport Simulation<dim>::step() {
   Kokkos::deep_copy(Kokkos::subview(a, fem), a_);
   Kokkos::deep_copy(Kokkos::subview(mass, fem), mass_);
   Kokkos::deep_copy(Kokkos::subview(pres, fem), prescribed_);
-  std::vector<const EnergyTerm<dim>*> terms;
+  std::vector<EnergyTerm<dim>*> terms;
   bool graph_rebuilt = false;
   if (nF > 0) terms.push_back(mpm_distributed_ ? local_elasticity_.get() : elasticity_.get());
   if (mpm_) {

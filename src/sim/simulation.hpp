@@ -130,6 +130,7 @@ class Simulation {
   const MpmBodies<dim>* mpm() const { return mpm_.get(); }
   NewtonSolver<dim>& newton() { return *newton_; }
   const Contact<dim>* contact() const { return contact_.get(); }
+  Contact<dim>* contact() { return contact_.get(); }
   // MPI (MPM distributed): the global particle id of each entry of
   // contact()->particle_forces() (the step's particle order, before migration).
   // contact_reported(): a step has reported contact forces (the same on every rank).

@@ -73,7 +73,7 @@ void DofSpace<dim>::build_maps() {
 }
 
 template <int dim>
-bool DofSpace<dim>::set_structure(LO n_nodes, const std::vector<const EnergyTerm<dim>*>& terms) {
+bool DofSpace<dim>::set_structure(LO n_nodes, const std::vector<EnergyTerm<dim>*>& terms) {
   std::vector<std::uint64_t> versions;
   versions.reserve(terms.size());
   for (const auto* t : terms) versions.push_back(t->couplings_version());
@@ -135,13 +135,13 @@ void DofSpace<dim>::rebuild(const std::string& cause) {
   count_cause(cause);
   Kokkos::Timer timer;
   if (!distributed()) {
-    A_ = Teuchos::rcp(new Matrix(build_dof_graph<dim>(terms_, n_nodes_, map_)));
+    A_ = Teuchos::rcp(new Matrix(build_dof_graph<dim>(couplers(), n_nodes_, map_)));
     A_->fillComplete();
   } else {
     if (slip_.count() > 0) throw std::invalid_argument("slip constraints run on 1 MPI rank only in this version");
     // Overlap graph (local ids), then the owned graph: each owned row holds the
     // union of its rows on all ranks (row lengths summed first: an upper bound).
-    auto G_ov = build_dof_graph<dim>(terms_, n_nodes_, overlap_map_, map_);
+    auto G_ov = build_dof_graph<dim>(couplers(), n_nodes_, overlap_map_, map_);
     Vector len_ov(overlap_map_), len(map_);
     {
       auto v = len_ov.getLocalViewHost(Tpetra::Access::OverwriteAll);

@@ -71,7 +71,7 @@ class DofSpace {
   // rebuilt (the matrix is new: its linear solver must be told), false when
   // the cached graph serves (same node count, same terms, same coupling
   // versions).
-  bool set_structure(LO n_nodes, const std::vector<const EnergyTerm<dim>*>& terms);
+  bool set_structure(LO n_nodes, const std::vector<EnergyTerm<dim>*>& terms);
   // Rebuilds the graph from the terms' couplings now (a term's update()
   // found couplings the graph lacks), counted under `cause`.
   void rebuild(const std::string& cause = "couplings found mid-solve");
@@ -83,7 +83,9 @@ class DofSpace {
   Teuchos::RCP<const Map> map() const { return map_; }
   Teuchos::RCP<const Map> overlap_map() const { return overlap_map_.is_null() ? map_ : overlap_map_; }
   Teuchos::RCP<Matrix> matrix() const { return A_; }
-  const std::vector<const EnergyTerm<dim>*>& terms() const { return terms_; }
+  const std::vector<EnergyTerm<dim>*>& terms() const { return terms_; }
+  // The terms as the graph builder sees them (add_couplings only).
+  std::vector<const EnergyTerm<dim>*> couplers() const { return {terms_.begin(), terms_.end()}; }
 
   // Assembly: zero the matrix values, hand out the sink, close.
   void begin_assembly();
@@ -158,7 +160,7 @@ class DofSpace {
   Teuchos::RCP<Vector> rhs_overlap_, x_overlap_, owned_tmp_;  // owned_tmp_: sum_shared
   Kokkos::View<LO*, MemSpace> diag_col_;  // distributed: column id of each owned row's diagonal
   void build_maps();
-  std::vector<const EnergyTerm<dim>*> terms_;
+  std::vector<EnergyTerm<dim>*> terms_;
   std::vector<std::uint64_t> versions_;
   // Scatter tables, per term: positions, stencil count, stencils_version().
   struct Table {

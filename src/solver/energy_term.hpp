@@ -82,14 +82,17 @@ class EnergyTerm {
   // bodies refill theirs every step) must be told (DeformationTerm::
   // set_stencils, MpmElasticityTerm::set_cells) before the next set_structure.
   virtual std::uint64_t stencils_version() const { return 0; }
+  // The two calls that change a term's state (contact: its pair set), so
+  // the only non-const ones; the evaluations above read that state and may
+  // use scratch buffers, but carry nothing from one call to the next.
   // Called at every Newton iterate x before its assembly (contact: the pairs
-  // near x; terms keep such caches as mutable state). Returns true when the term now needs couplings the current graph
+  // near x). Returns true when the term now needs couplings the current graph
   // lacks; the solver then rebuilds the graph (add_couplings is asked again).
-  virtual bool update(ConstDofView /*x*/) const { return false; }
+  virtual bool update(ConstDofView /*x*/) { return false; }
   // Called once the Newton direction p is known, before max_step and the
   // energies of the line search along x + t p, t in [0, 1] (contact: the pairs
   // the segment can bring within reach).
-  virtual void prepare_direction(ConstDofView /*x*/, ConstDofView /*p*/) const {}
+  virtual void prepare_direction(ConstDofView /*x*/, ConstDofView /*p*/) {}
 };
 
 // Elasticity over deformation stencils (FEM elements or MPM particles).

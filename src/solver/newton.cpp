@@ -179,7 +179,7 @@ void NewtonSolver<dim>::set_partition(std::vector<GO> global_nodes, const std::v
 }
 
 template <int dim>
-bool NewtonSolver<dim>::set_system(LO n_nodes, std::vector<const EnergyTerm<dim>*> terms) {
+bool NewtonSolver<dim>::set_system(LO n_nodes, std::vector<EnergyTerm<dim>*> terms) {
   if (impl_->comm->getSize() > 1 && !impl_->dofs.distributed())
     throw std::invalid_argument(
         "the Newton solver runs on " + std::to_string(impl_->comm->getSize()) +
@@ -304,7 +304,7 @@ NewtonStats NewtonSolver<dim>::minimize(const IncrementalPotential& ip, View1 x,
 
     timer.reset();
     bool grow = false;
-    for (const auto* t : m.dofs.terms()) grow = t->update(x) || grow;
+    for (auto* t : m.dofs.terms()) grow = t->update(x) || grow;
     grow = m.all_max(grow ? 1.0 : 0.0) > 0;
     if (grow) {
       m.dofs.rebuild("pairs found mid-solve");
@@ -429,7 +429,7 @@ NewtonStats NewtonSolver<dim>::minimize(const IncrementalPotential& ip, View1 x,
     };
     // The largest step along dir the terms allow (CCD, inversion), all ranks.
     auto step_bound = [&]() {
-      for (const auto* t : m.dofs.terms()) t->prepare_direction(x, dir);
+      for (auto* t : m.dofs.terms()) t->prepare_direction(x, dir);
       double bound = std::numeric_limits<double>::infinity();
       for (const auto* t : m.dofs.terms()) bound = std::min(bound, t->max_step(x, dir));
       return m.all_min(bound);

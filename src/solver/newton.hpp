@@ -127,7 +127,7 @@ class NewtonSolver {
   // space rebuilds the graph (and the linear solver its symbolic phase) only
   // when the node count or a term's couplings changed; returns true then. The
   // terms must outlive the next minimize().
-  bool set_system(LO n_nodes, std::vector<const EnergyTerm<dim>*> terms);
+  bool set_system(LO n_nodes, std::vector<EnergyTerm<dim>*> terms);
 
   // A new time step: the linear solver's next solve factorises (Cholmod
   // reuses a factor only within one step, so a restarted run takes the same

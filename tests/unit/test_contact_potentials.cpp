@@ -149,7 +149,7 @@ TEST(ContactPotentials, BarrierDerivatives2D) {
   auto s = make_scene<2>({Vec<2>(0.5, 1.03), Vec<2>(1.02, 1.03), Vec<2>(1.04, 0.4), Vec<2>(0.97, 1.06)},
                          params(0.1));
   perturb<2>(s.x, 2e-3, 3);
-  auto& barrier = const_cast<BarrierTerm<2>&>(*s.contact->barrier());
+  auto& barrier = *s.contact->barrier();
   // Exact derivatives, also through a sink with project = false (b' grad^2 d
   // makes the local Hessians indefinite: the projection changes them).
   fixtures::check_exact_term<2>(barrier, s.n_nodes, s.x, kFdStep, 1e-5);
@@ -162,7 +162,7 @@ TEST(ContactPotentials, BarrierDerivatives3D) {
                           Vec<3>(-0.02, -0.03, -0.02)},
                          params(0.1));
   perturb<3>(s.x, 2e-3, 5);
-  auto& barrier = const_cast<BarrierTerm<3>&>(*s.contact->barrier());
+  auto& barrier = *s.contact->barrier();
   fixtures::check_exact_term<3>(barrier, s.n_nodes, s.x, kFdStep, 1e-5);
 }
 
@@ -178,7 +178,7 @@ TEST(ContactPotentials, GraphGrowsByTheMissingPairs) {
   // its stencil (nodes y = 1.5 .. 1.7) apart from particle 1's (0.9 .. 1.1).
   // The new pairs (particle 0) sort before the graph's (particle 1).
   auto s = make_scene<2>({Vec<2>(0.3, 1.6), Vec<2>(0.5, 1.03)}, params(0.1));
-  auto& barrier = const_cast<BarrierTerm<2>&>(*s.contact->barrier());
+  auto& barrier = *s.contact->barrier();
   const auto v0 = barrier.couplings_version();
   EXPECT_FALSE(barrier.update(s.x));
   EXPECT_EQ(barrier.couplings_version(), v0);
@@ -303,7 +303,7 @@ void by_cell_case() {
       }
   auto s = lagged_friction_scene<dim>(pts, 3e-3);
   ASSERT_FALSE(::testing::Test::HasFailure());
-  auto& barrier = const_cast<BarrierTerm<dim>&>(*s.contact->barrier());
+  auto& barrier = *s.contact->barrier();
   const auto& friction = *s.contact->friction();
   ASSERT_NE(barrier.cells(), nullptr);
   const ParticleCells<dim> cells = *barrier.cells();
@@ -381,7 +381,7 @@ TEST(ContactPotentials, CandidateSearchesFindTheSamePairsAsSearchesOverAllPartic
   for (int i = 0; i < 9; ++i)
     for (const double y : {1.03, 1.15, 1.25, 1.35, 1.65, 1.75}) pts.push_back(Vec<2>(0.1 + 0.1 * i, y));
   auto s = make_scene<2>(pts, params(0.1));
-  auto& cand = const_cast<BarrierTerm<2>&>(*s.contact->barrier());
+  auto& cand = *s.contact->barrier();
   BarrierTerm<2> all(cand.primitives(), cand.dhat(), cand.kappa());
   all.set_graph_margin(3.0);
   all.set_candidate_search(false);
