@@ -63,6 +63,39 @@ KOKKOS_INLINE_FUNCTION double abs_permanent(const Mat<dim>& M) {
   }
 }
 
+// A sufficient test, much cheaper than the polynomial below, that
+// det(T + a dT) > 0 for every a in [0, cap]: det(T + a dT) = det T det(I +
+// a M) with M = T^-1 dT = adj(T) dT / det T, and I + a M is invertible while
+// a ||M|| < 1 in an induced norm, so det(T + a dT) keeps det T's sign. True
+// when det T exceeds 16 u perm|T| (so the computed det T is within a quarter
+// of the true one) and cap ||adj(T) dT||_inf <= det T / 2, the norm taken
+// with each cofactor's rounding bound (a (dim-1)-determinant: 6 u max|T|^(dim-1))
+// and the products' added to the magnitudes; the factor 2 leaves room for
+// the rest. False says nothing (the caller computes the root).
+template <int dim>
+KOKKOS_INLINE_FUNCTION bool positive_up_to(const Mat<dim>& T, const Mat<dim>& dT, double cap) {
+  const Mat<dim> C = cofactors<dim>(T);
+  double det = 0.0;
+  for (int i = 0; i < dim; ++i) det += T(i, 0) * C(i, 0);
+  if (!(det > 16.0 * kRoundoff * abs_permanent<dim>(T))) return false;
+  const double tmax = T.cwiseAbs().maxCoeff();
+  const double e = 6.0 * kRoundoff * (dim == 2 ? tmax : tmax * tmax);
+  double norm = 0.0;  // ||adj(T) dT||_inf, adj(T)(i, k) = C(k, i)
+  for (int i = 0; i < dim; ++i) {
+    double row = 0.0;
+    for (int j = 0; j < dim; ++j) {
+      double v = 0.0, err = 0.0;
+      for (int k = 0; k < dim; ++k) {
+        v += C(k, i) * dT(k, j);
+        err += (e + 4.0 * kRoundoff * std::abs(C(k, i))) * std::abs(dT(k, j));
+      }
+      row += std::abs(v) + err;
+    }
+    if (!(row <= norm)) norm = row;  // a NaN row makes the norm NaN
+  }
+  return cap * norm <= 0.5 * det;  // (false for a NaN or an overflow)
+}
+
 // det(T + a dT) = sum_k c[k] a^k, with T and dT already scaled to O(1).
 template <int dim>
 struct DetPolynomial {
@@ -242,7 +275,8 @@ struct DetPolynomial {
 // cap (optional, > 0): +infinity also when det(T + alpha dT) is certified
 // positive for every alpha in [0, cap], whatever lies beyond (a caller that
 // never steps past cap needs no root there; the root's refinement is most of
-// the cost).
+// the cost). Certified first by det_root_detail::positive_up_to, then by the
+// polynomial's sign tests.
 template <int dim>
 KOKKOS_INLINE_FUNCTION double smallest_positive_det_root(const Mat<dim>& T, const Mat<dim>& dT,
                                                          double cap = std::numeric_limits<double>::infinity()) {
@@ -250,6 +284,9 @@ KOKKOS_INLINE_FUNCTION double smallest_positive_det_root(const Mat<dim>& T, cons
   const double t_max = T.cwiseAbs().maxCoeff(), d_max = dT.cwiseAbs().maxCoeff();
   if (!T.allFinite() || !dT.allFinite() || t_max == 0.0) return 0.0;
   if (d_max == 0.0) return det_root_detail::determinant<dim>(T) > 0.0 ? inf : 0.0;
+  // Most stencils of a Newton step: dT small against T, cleared to cap
+  // without the polynomial (its eight mixed determinants and permanents).
+  if (cap < inf && det_root_detail::positive_up_to<dim>(T, dT, cap)) return inf;
   int et = 0, ed = 0;
   std::frexp(t_max, &et), std::frexp(d_max, &ed);
   // det(T + a dT) = 2^(dim et) det(Ts + beta dTs) with beta = a 2^(ed - et).

@@ -243,4 +243,59 @@ TYPED_TEST(DetRootTest, CapReturnsTheRootBelowItAndInfBeyond) {
   EXPECT_EQ(smallest_positive_det_root<d>(diag<d>(-1, 1, 1), I, 1.0), 0.0);
 }
 
+// det_root_detail::positive_up_to, the cheap clearance tried before the
+// polynomial: it must never clear a cap at or beyond a root (random T, also
+// nearly singular, with steps dT from 1e-6 to 10 times T's size, and steps
+// along -T whose root is known exactly), and it must clear most small steps,
+// which is what it is for.
+TYPED_TEST(DetRootTest, CheapClearanceNeverCoversARootAndServesSmallSteps) {
+  constexpr int d = TypeParam::value;
+  std::mt19937 rng(29);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  int cleared = 0, small = 0, small_cleared = 0;
+  for (int t = 0; t < 2000; ++t) {
+    Mat<d> T = random_matrix<d>(rng);
+    if (t % 4 == 1) T.col(1) = T.col(0) + 1e-6 * T.col(1);  // nearly singular
+    if (T.determinant() < 0) T.col(0) *= -1.0;
+    if (!(T.determinant() > 0)) continue;
+    const double s = std::pow(10.0, -6.0 + 7.0 * u(rng));
+    const Mat<d> dT = s * random_matrix<d>(rng);
+    const double root = smallest_positive_det_root<d>(T, dT);
+    for (const double f : {0.25, 0.5, 0.9, 0.999, 1.0, 1.001, 1.5, 2.0, 4.0}) {
+      const double cap = std::isfinite(root) ? f * root : f;
+      if (!det_root_detail::positive_up_to<d>(T, dT, cap)) continue;
+      ++cleared;
+      EXPECT_TRUE(!(root <= cap)) << "cleared cap " << cap << " at or beyond the root " << root << " (s " << s << ")";
+    }
+    if (s < 1e-3 && t % 4 != 1) {
+      ++small;
+      if (det_root_detail::positive_up_to<d>(T, dT, 1.0 / 0.9)) ++small_cleared;
+    }
+  }
+  EXPECT_GT(cleared, 1000);
+  EXPECT_GT(small_cleared, 0.9 * small) << small_cleared << " of " << small;
+  // Along -sigma T the root is 1 / sigma exactly and ||T^-1 dT|| = sigma.
+  for (const double sigma : {1e-8, 0.3, 1.0, 7.0}) {
+    const Mat<d> T = diag<d>(1, 2, 3) + 0.1 * Mat<d>::Ones();
+    const Mat<d> dT = -sigma * T;
+    EXPECT_TRUE(det_root_detail::positive_up_to<d>(T, dT, 0.4 / sigma)) << sigma;
+    for (const double f : {1.0, 1.5, 1.9, 3.0})
+      EXPECT_FALSE(det_root_detail::positive_up_to<d>(T, dT, f / sigma)) << sigma << " cap x " << f;
+  }
+  // det T zero up to rounding (a column a multiple of another, each entry
+  // rounded) and a step of nothing: the computed det T may come out positive
+  // while the true one is not, so it is not cleared on det T's sign alone.
+  for (int t = 0; t < 200; ++t) {
+    Mat<d> T = random_matrix<d>(rng);
+    T.col(1) = (0.7 + 0.001 * t) * T.col(0);
+    const Mat<d> dT = 1e-30 * random_matrix<d>(rng);
+    if (det_root_detail::positive_up_to<d>(T, dT, 1.0)) {
+      EXPECT_GT(det_ld<d>(T, dT, 0.0L), 0.0L) << "cleared a singular T, case " << t;
+    }
+  }
+  // Not positive, not finite: never cleared.
+  EXPECT_FALSE(det_root_detail::positive_up_to<d>(diag<d>(-1, 1, 1), 1e-9 * Mat<d>::Identity(), 1.0));
+  EXPECT_FALSE(det_root_detail::positive_up_to<d>(Mat<d>::Identity(), Mat<d>::Constant(NAN), 1.0));
+}
+
 }  // namespace
