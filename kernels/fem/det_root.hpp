@@ -67,17 +67,21 @@ KOKKOS_INLINE_FUNCTION double abs_permanent(const Mat<dim>& M) {
 // det(T + a dT) > 0 for every a in [0, cap]: det(T + a dT) = det T det(I +
 // a M) with M = T^-1 dT = adj(T) dT / det T, and I + a M is invertible while
 // a ||M|| < 1 in an induced norm, so det(T + a dT) keeps det T's sign. True
-// when det T exceeds 16 u perm|T| (so the computed det T is within a quarter
+// when det T exceeds 16 u perm|T| (so the computed det T is within a third
 // of the true one) and cap ||adj(T) dT||_inf <= det T / 2, the norm taken
-// with each cofactor's rounding bound (a (dim-1)-determinant: 6 u max|T|^(dim-1))
-// and the products' added to the magnitudes; the factor 2 leaves room for
-// the rest. False says nothing (the caller computes the root).
+// with each cofactor's rounding bound (a (dim-1)-determinant: 6 u
+// max|T|^(dim-1); 2D's are exact) and the products' added to the
+// magnitudes; the factor 2 leaves room for the rest. These are relative
+// bounds: T and dT must be scaled to O(1) (as smallest_positive_det_root
+// does), and a permanent below 2^-900, where underflow would make them
+// absolute, is refused. False says nothing (the caller computes the root).
 template <int dim>
 KOKKOS_INLINE_FUNCTION bool positive_up_to(const Mat<dim>& T, const Mat<dim>& dT, double cap) {
   const Mat<dim> C = cofactors<dim>(T);
   double det = 0.0;
   for (int i = 0; i < dim; ++i) det += T(i, 0) * C(i, 0);
-  if (!(det > 16.0 * kRoundoff * abs_permanent<dim>(T))) return false;
+  const double perm = abs_permanent<dim>(T);
+  if (!(perm > 0x1p-900) || !(det > 16.0 * kRoundoff * perm)) return false;
   const double tmax = T.cwiseAbs().maxCoeff();
   const double e = 6.0 * kRoundoff * (dim == 2 ? tmax : tmax * tmax);
   double norm = 0.0;  // ||adj(T) dT||_inf, adj(T)(i, k) = C(k, i)
@@ -91,7 +95,8 @@ KOKKOS_INLINE_FUNCTION bool positive_up_to(const Mat<dim>& T, const Mat<dim>& dT
       }
       row += std::abs(v) + err;
     }
-    if (!(row <= norm)) norm = row;  // a NaN row makes the norm NaN
+    if (std::isnan(row)) return false;
+    norm = std::fmax(norm, row);
   }
   return cap * norm <= 0.5 * det;  // (false for a NaN or an overflow)
 }
@@ -284,14 +289,16 @@ KOKKOS_INLINE_FUNCTION double smallest_positive_det_root(const Mat<dim>& T, cons
   const double t_max = T.cwiseAbs().maxCoeff(), d_max = dT.cwiseAbs().maxCoeff();
   if (!T.allFinite() || !dT.allFinite() || t_max == 0.0) return 0.0;
   if (d_max == 0.0) return det_root_detail::determinant<dim>(T) > 0.0 ? inf : 0.0;
-  // Most stencils of a Newton step: dT small against T, cleared to cap
-  // without the polynomial (its eight mixed determinants and permanents).
-  if (cap < inf && det_root_detail::positive_up_to<dim>(T, dT, cap)) return inf;
   int et = 0, ed = 0;
   std::frexp(t_max, &et), std::frexp(d_max, &ed);
   // det(T + a dT) = 2^(dim et) det(Ts + beta dTs) with beta = a 2^(ed - et).
-  const det_root_detail::DetPolynomial<dim> p(std::ldexp(1.0, -et) * T, std::ldexp(1.0, -ed) * dT);
-  return std::ldexp(p.smallest_positive_root(std::ldexp(cap, ed - et)), et - ed);
+  const Mat<dim> Ts = std::ldexp(1.0, -et) * T, dTs = std::ldexp(1.0, -ed) * dT;
+  const double cap_s = std::ldexp(cap, ed - et);
+  // Most stencils of a Newton step: dT small against T, cleared to cap
+  // without the polynomial (its eight mixed determinants and permanents).
+  if (cap_s < inf && det_root_detail::positive_up_to<dim>(Ts, dTs, cap_s)) return inf;
+  const det_root_detail::DetPolynomial<dim> p(Ts, dTs);
+  return std::ldexp(p.smallest_positive_root(cap_s), et - ed);
 }
 
 }  // namespace bfemp

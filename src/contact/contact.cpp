@@ -246,7 +246,7 @@ void Contact<dim>::begin_step(const MpmBodies<dim>* mpm, ConstDofView x) {
 
 template <int dim>
 LO Contact<dim>::update_friction(ConstDofView x, ConstDofView x_ref, double s, double dt) {
-  return friction_ ? friction_->update_lagged(x, x_ref, s, dt) : 0;
+  return friction_ ? friction_->update_lagged(x, barrier_->active_pairs(x), x_ref, s, dt) : 0;
 }
 
 template <int dim>

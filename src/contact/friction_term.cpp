@@ -10,7 +10,7 @@
 namespace bfemp {
 
 template <int dim>
-FrictionTerm<dim>::FrictionTerm(BarrierTerm<dim>& barrier, std::vector<double> mu, int n_fem_bodies,
+FrictionTerm<dim>::FrictionTerm(const BarrierTerm<dim>& barrier, std::vector<double> mu, int n_fem_bodies,
                                 double eps_v)
     : barrier_(barrier), n_fem_(n_fem_bodies), eps_v_(eps_v) {
   mu_ = Kokkos::View<double*, MemSpace>("friction_mu", mu.size());
@@ -18,8 +18,8 @@ FrictionTerm<dim>::FrictionTerm(BarrierTerm<dim>& barrier, std::vector<double> m
 }
 
 template <int dim>
-LO FrictionTerm<dim>::update_lagged(ConstDofView x, ConstDofView x_ref, double s, double dt) {
-  const auto act = barrier_.active_pairs(x);
+LO FrictionTerm<dim>::update_lagged(ConstDofView x, const typename BarrierTerm<dim>::ActivePairs& act,
+                                    ConstDofView x_ref, double s, double dt) {
   const auto& ps = barrier_.particles();
   const auto& prims = barrier_.primitives();
   s_ = s;

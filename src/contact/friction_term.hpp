@@ -22,13 +22,14 @@ template <int dim>
 class FrictionTerm : public EnergyTerm<dim> {
  public:
   // mu(mpm body, fem body) as a row-major table [n_mpm x n_fem].
-  FrictionTerm(BarrierTerm<dim>& barrier, std::vector<double> mu, int n_fem_bodies, double eps_v);
+  FrictionTerm(const BarrierTerm<dim>& barrier, std::vector<double> mu, int n_fem_bodies, double eps_v);
   std::string name() const override { return "friction"; }
 
-  // Lags lambda, T, c at x from the barrier's active pairs (which moves the
-  // barrier's pair set to x); x_ref, s as above. Returns the number of pairs
-  // with mu lambda != 0.
-  LO update_lagged(ConstDofView x, ConstDofView x_ref, double s, double dt);
+  // Lags lambda, T, c at x from the barrier's active pairs there (`act`, from
+  // BarrierTerm::active_pairs(x)); x_ref, s as above. Returns the number of
+  // pairs with mu lambda != 0.
+  LO update_lagged(ConstDofView x, const typename BarrierTerm<dim>::ActivePairs& act, ConstDofView x_ref, double s,
+                   double dt);
   void clear() { n_ = 0; }
   LO pairs() const { return n_; }
 
@@ -46,7 +47,7 @@ class FrictionTerm : public EnergyTerm<dim> {
   void assemble_by_particle(ConstDofView x, const Sink<dim>& sink, bool hessian) const;
   FrictionSliding<dim> sliding(ConstDofView x) const;
 
-  BarrierTerm<dim>& barrier_;
+  const BarrierTerm<dim>& barrier_;
   Kokkos::View<double*, MemSpace> mu_;  // [n_mpm * n_fem]
   int n_fem_;
   double eps_v_;

@@ -276,7 +276,9 @@ TYPED_TEST(DetRootTest, CheapClearanceNeverCoversARootAndServesSmallSteps) {
   EXPECT_GT(small_cleared, 0.9 * small) << small_cleared << " of " << small;
   // Along -sigma T the root is 1 / sigma exactly and ||T^-1 dT|| = sigma.
   for (const double sigma : {1e-8, 0.3, 1.0, 7.0}) {
-    const Mat<d> T = diag<d>(1, 2, 3) + 0.1 * Mat<d>::Ones();
+    Mat<d> T = diag<d>(1, 2, 3);
+    T(0, 1) = 0.7;  // not symmetric: adj(T) and its transpose differ
+    T(d - 1, 0) = -0.4;
     const Mat<d> dT = -sigma * T;
     EXPECT_TRUE(det_root_detail::positive_up_to<d>(T, dT, 0.4 / sigma)) << sigma;
     for (const double f : {1.0, 1.5, 1.9, 3.0})
@@ -292,6 +294,31 @@ TYPED_TEST(DetRootTest, CheapClearanceNeverCoversARootAndServesSmallSteps) {
     if (det_root_detail::positive_up_to<d>(T, dT, 1.0)) {
       EXPECT_GT(det_ld<d>(T, dT, 0.0L), 0.0L) << "cleared a singular T, case " << t;
     }
+  }
+  // Through smallest_positive_det_root, which scales T and dT to O(1)
+  // first: scaling both by 2^+-300 changes no answer, and inputs at the
+  // edges of the double range are not cleared wrongly (an already inverted
+  // T near underflow: det -2^-1080; entries near 1e100 whose products
+  // overflow in an unscaled test, with a root at 1e-9).
+  std::mt19937 rng2(31);
+  for (int t = 0; t < 300; ++t) {
+    Mat<d> T = random_matrix<d>(rng2);
+    if (T.determinant() < 0) T.col(0) *= -1.0;
+    const Mat<d> dT = std::pow(10.0, -4.0 + 4.0 * u(rng2)) * random_matrix<d>(rng2);
+    const double ref = smallest_positive_det_root<d>(T, dT, 1.0 / 0.9);
+    for (const int e : {-300, 300})
+      EXPECT_EQ(smallest_positive_det_root<d>(std::ldexp(1.0, e) * T, std::ldexp(1.0, e) * dT, 1.0 / 0.9), ref)
+          << "scale 2^" << e << ", case " << t;
+  }
+  if constexpr (d == 3) {
+    Mat<d> T;
+    T << 1, 1, -81, 1, -1, 0, 1, 0, -40;  // det -1
+    EXPECT_EQ(smallest_positive_det_root<d>(std::ldexp(1.0, -360) * T, std::ldexp(1.0, -380) * Mat<d>::Identity(), 1.0),
+              0.0);
+    Mat<d> A, B;
+    A << 1, 1, 0, -1, 1, 0, 0, 0, 1;
+    B << 1, 1, 0, 1, -1, 0, 0, 0, 0;  // det(A + s B) = 2 (1 + s)(1 - s): s = 1e9 a reaches 0 at a = 1e-9
+    expect_root(smallest_positive_det_root<d>(1e100 * A, 1e109 * B, 1.0), 1e-9, 1e-6);
   }
   // Not positive, not finite: never cleared.
   EXPECT_FALSE(det_root_detail::positive_up_to<d>(diag<d>(-1, 1, 1), 1e-9 * Mat<d>::Identity(), 1.0));
