@@ -165,8 +165,9 @@ class BarrierTerm : public EnergyTerm<dim> {
   // Scratch of the evaluations (energy, gradient, assemble, max_step) and the
   // searches: positions (and sweeps) of the particles at the call's x (p),
   // and the particles' summed blocks. Kept for their capacity only: every
-  // call writes what it reads first, so nothing passes from one call to the
-  // next.
+  // call writes what it reads first, so no value passes from one call to the
+  // next (the sums' particle marks are all zero between calls: each
+  // assemble() clears those it set, particle_expansion.hpp).
   mutable Kokkos::View<double*, MemSpace> xq_, dq_;
   mutable ParticleSums<dim> sums_;
   // Statistics for the step's report, never read by a computation.

@@ -62,7 +62,8 @@ class FrictionTerm : public EnergyTerm<dim> {
   LO n_seg_ = 0;
   // Scratch of the evaluations (kept for its capacity; every call writes
   // what it reads): the pairs' particles at x and x_ref, and assemble()'s
-  // per-particle sums (with the barrier's cells).
+  // per-particle sums (with the barrier's cells; their marks are all zero
+  // between calls).
   mutable Kokkos::View<double*, MemSpace> xq_, xq_ref_;
   mutable ParticleSums<dim> sums_;
 };

@@ -84,7 +84,8 @@ class EnergyTerm {
   virtual std::uint64_t stencils_version() const { return 0; }
   // The two calls that change a term's state (contact: its pair set), so
   // the only non-const ones; the evaluations above read that state and may
-  // use scratch buffers, but carry nothing from one call to the next.
+  // use scratch buffers, but carry no value from one call to the next
+  // (statistics aside, such as the contact term's CCD minimum and timings).
   // Called at every Newton iterate x before its assembly (contact: the pairs
   // near x). Returns true when the term now needs couplings the current graph
   // lacks; the solver then rebuilds the graph (add_couplings is asked again).
