@@ -72,9 +72,10 @@ KOKKOS_INLINE_FUNCTION double abs_permanent(const Mat<dim>& M) {
 // with each cofactor's rounding bound (a (dim-1)-determinant: 6 u
 // max|T|^(dim-1); 2D's are exact) and the products' added to the
 // magnitudes; the factor 2 leaves room for the rest. These are relative
-// bounds: T and dT must be scaled to O(1) (as smallest_positive_det_root
-// does), and a permanent below 2^-900, where underflow would make them
-// absolute, is refused. False says nothing (the caller computes the root).
+// bounds: max|T| and max|dT| must lie in [2^-250, 2^250] (products up to
+// 2^751 in 3D, far from overflow; smallest_positive_det_root scales other
+// inputs by powers of two), and a permanent below 2^-900, where underflow
+// would make them absolute, is refused. False says nothing (the caller computes the root).
 template <int dim>
 KOKKOS_INLINE_FUNCTION bool positive_up_to(const Mat<dim>& T, const Mat<dim>& dT, double cap) {
   const Mat<dim> C = cofactors<dim>(T);
@@ -96,7 +97,7 @@ KOKKOS_INLINE_FUNCTION bool positive_up_to(const Mat<dim>& T, const Mat<dim>& dT
       row += std::abs(v) + err;
     }
     if (std::isnan(row)) return false;
-    norm = std::fmax(norm, row);
+    norm = row > norm ? row : norm;  // (no NaN here; std::fmax may be a call)
   }
   return cap * norm <= 0.5 * det;  // (false for a NaN or an overflow)
 }
@@ -289,14 +290,29 @@ KOKKOS_INLINE_FUNCTION double smallest_positive_det_root(const Mat<dim>& T, cons
   const double t_max = T.cwiseAbs().maxCoeff(), d_max = dT.cwiseAbs().maxCoeff();
   if (!T.allFinite() || !dT.allFinite() || t_max == 0.0) return 0.0;
   if (d_max == 0.0) return det_root_detail::determinant<dim>(T) > 0.0 ? inf : 0.0;
+  // Most stencils of a Newton step: dT small against T, cleared to cap
+  // without the polynomial (its eight mixed determinants and permanents).
+  // Its bounds hold for max|T|, max|dT| in [2^-250, 2^250], where scaling by
+  // powers of two would change none of its bits: such T, dT go in raw (the
+  // scaling's frexp/ldexp calls would cost most of the clearance); others
+  // are scaled to O(1) first. One call site keeps the clearance inlined once.
+  constexpr double lo = 0x1p-250, hi = 0x1p+250;
+  const bool in_range = t_max >= lo && t_max <= hi && d_max >= lo && d_max <= hi;
+  if (cap < inf) {
+    Mat<dim> Tc = T, dTc = dT;
+    double cap_c = cap;
+    if (!in_range) {
+      int et = 0, ed = 0;
+      std::frexp(t_max, &et), std::frexp(d_max, &ed);
+      Tc *= std::ldexp(1.0, -et), dTc *= std::ldexp(1.0, -ed), cap_c = std::ldexp(cap, ed - et);
+    }
+    if (cap_c < inf && det_root_detail::positive_up_to<dim>(Tc, dTc, cap_c)) return inf;
+  }
   int et = 0, ed = 0;
   std::frexp(t_max, &et), std::frexp(d_max, &ed);
   // det(T + a dT) = 2^(dim et) det(Ts + beta dTs) with beta = a 2^(ed - et).
   const Mat<dim> Ts = std::ldexp(1.0, -et) * T, dTs = std::ldexp(1.0, -ed) * dT;
   const double cap_s = std::ldexp(cap, ed - et);
-  // Most stencils of a Newton step: dT small against T, cleared to cap
-  // without the polynomial (its eight mixed determinants and permanents).
-  if (cap_s < inf && det_root_detail::positive_up_to<dim>(Ts, dTs, cap_s)) return inf;
   const det_root_detail::DetPolynomial<dim> p(Ts, dTs);
   return std::ldexp(p.smallest_positive_root(cap_s), et - ed);
 }

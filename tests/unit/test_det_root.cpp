@@ -295,8 +295,9 @@ TYPED_TEST(DetRootTest, CheapClearanceNeverCoversARootAndServesSmallSteps) {
       EXPECT_GT(det_ld<d>(T, dT, 0.0L), 0.0L) << "cleared a singular T, case " << t;
     }
   }
-  // Through smallest_positive_det_root, which scales T and dT to O(1)
-  // first: scaling both by 2^+-300 changes no answer, and inputs at the
+  // Through smallest_positive_det_root, which clears raw T and dT inside
+  // [2^-250, 2^250] and scales them to O(1) outside: scaling both by
+  // 2^+-240 (raw) or 2^+-300 (scaled) changes no answer, and inputs at the
   // edges of the double range are not cleared wrongly (an already inverted
   // T near underflow: det -2^-1080; entries near 1e100 whose products
   // overflow in an unscaled test, with a root at 1e-9).
@@ -306,7 +307,7 @@ TYPED_TEST(DetRootTest, CheapClearanceNeverCoversARootAndServesSmallSteps) {
     if (T.determinant() < 0) T.col(0) *= -1.0;
     const Mat<d> dT = std::pow(10.0, -4.0 + 4.0 * u(rng2)) * random_matrix<d>(rng2);
     const double ref = smallest_positive_det_root<d>(T, dT, 1.0 / 0.9);
-    for (const int e : {-300, 300})
+    for (const int e : {-300, -240, 240, 300})
       EXPECT_EQ(smallest_positive_det_root<d>(std::ldexp(1.0, e) * T, std::ldexp(1.0, e) * dT, 1.0 / 0.9), ref)
           << "scale 2^" << e << ", case " << t;
   }
