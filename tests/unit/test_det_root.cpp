@@ -295,12 +295,12 @@ TYPED_TEST(DetRootTest, CheapClearanceNeverCoversARootAndServesSmallSteps) {
       EXPECT_GT(det_ld<d>(T, dT, 0.0L), 0.0L) << "cleared a singular T, case " << t;
     }
   }
-  // Through smallest_positive_det_root, which clears raw T and dT inside
-  // [2^-250, 2^250] and scales them to O(1) outside: scaling both by
-  // 2^+-240 (raw) or 2^+-300 (scaled) changes no answer, and inputs at the
-  // edges of the double range are not cleared wrongly (an already inverted
-  // T near underflow: det -2^-1080; entries near 1e100 whose products
-  // overflow in an unscaled test, with a root at 1e-9).
+  // Through smallest_positive_det_root, which tries the clearance on raw T
+  // and dT and scales them to O(1) for the polynomial: scaling both by
+  // 2^+-240 or 2^+-300 changes no answer, and inputs at the edges of the
+  // double range are not cleared wrongly (an already inverted T near
+  // underflow: det -2^-1080; entries near 1e100 whose products overflow in
+  // the unscaled clearance, with a root at 1e-9).
   std::mt19937 rng2(31);
   for (int t = 0; t < 300; ++t) {
     Mat<d> T = random_matrix<d>(rng2);
