@@ -72,21 +72,32 @@ KOKKOS_INLINE_FUNCTION double abs_permanent(const Mat<dim>& M) {
 // with each cofactor's rounding bound (a (dim-1)-determinant: 6 u
 // max|T|^(dim-1); 2D's are exact) and the products' added to the
 // magnitudes; the factor 2 leaves room for the rest.
-// Any finite T, dT, unscaled (scaling them by powers of two would cost more
-// than the test): an overflow makes det, the permanent or a row infinite or
-// NaN, and every such case answers false (a NaN row returns at once; a later
-// row must not hide it). Underflow makes the rounding bounds absolute, at
-// most 2^-1074 per product: a permanent below 2^-900 is refused, so det T >
-// 2^-949 and, with cap <= 2^64, the lost amounts are below 2^-1000, far
-// inside the factor 2. False says nothing (the caller computes the root).
+// Any finite T, dT, unscaled (scaling them by powers of two would triple
+// the cost of a cleared 2D stencil):
+// - overflow: a row that overflows is infinite or NaN and answers false (a
+//   NaN row at once: a later row must not hide it); det T must be finite
+//   (in 3D a cofactor's product may overflow while the permanent, grouped
+//   differently, does not: det T = +inf would pass any test against it);
+// - underflow makes the rounding bounds absolute: 2^-1075 a product, and in
+//   3D a cofactor's is multiplied by T(i, 0), so det T must also exceed
+//   2^-1070 max|T| (a five-fold margin); a permanent below 2^-900 is refused,
+//   so det T > 2^-949 and, with cap <= 2^64, the products of the norm lose
+//   less than 2^-1000, far inside the factor 2.
+// (Counterexamples to the versions without the finite-det and the 3D
+// absolute term are in the test.) False says nothing (the caller computes
+// the root).
 template <int dim>
 KOKKOS_INLINE_FUNCTION bool positive_up_to(const Mat<dim>& T, const Mat<dim>& dT, double cap) {
   const Mat<dim> C = cofactors<dim>(T);
   double det = 0.0;
   for (int i = 0; i < dim; ++i) det += T(i, 0) * C(i, 0);
   const double perm = abs_permanent<dim>(T);
-  if (!(perm > 0x1p-900) || !(det > 16.0 * kRoundoff * perm)) return false;
   const double tmax = T.cwiseAbs().maxCoeff();
+  // 3D: a cofactor's underflow (2^-1074), amplified by T(i, 0). Below max|T|
+  // = 2^100 it is under 2^-972, inside the margin of 16 u perm > 2^-949;
+  // and 2^-1070 max|T| is subnormal there, which would cost 20 ns a call.
+  const double lost = dim == 3 && tmax > 0x1p100 ? 0x1p-1070 * tmax : 0.0;
+  if (!(perm > 0x1p-900) || !(det > 16.0 * kRoundoff * perm + lost) || !(det < 0x1p1023)) return false;
   const double e = 6.0 * kRoundoff * (dim == 2 ? tmax : tmax * tmax);
   double norm = 0.0;  // ||adj(T) dT||_inf, adj(T)(i, k) = C(k, i)
   for (int i = 0; i < dim; ++i) {
@@ -102,7 +113,7 @@ KOKKOS_INLINE_FUNCTION bool positive_up_to(const Mat<dim>& T, const Mat<dim>& dT
     if (std::isnan(row)) return false;
     norm = row > norm ? row : norm;  // (no NaN here; std::fmax may be a call)
   }
-  return cap <= 0x1p64 && cap * norm <= 0.5 * det;  // (false for an overflow)
+  return cap <= 0x1p64 && cap * norm <= 0.5 * det;  // (false when cap * norm overflows)
 }
 
 // det(T + a dT) = sum_k c[k] a^k, with T and dT already scaled to O(1).
@@ -292,11 +303,15 @@ KOKKOS_INLINE_FUNCTION double smallest_positive_det_root(const Mat<dim>& T, cons
   constexpr double inf = std::numeric_limits<double>::infinity();
   const double t_max = T.cwiseAbs().maxCoeff(), d_max = dT.cwiseAbs().maxCoeff();
   if (!T.allFinite() || !dT.allFinite() || t_max == 0.0) return 0.0;
-  if (d_max == 0.0) return det_root_detail::determinant<dim>(T) > 0.0 ? inf : 0.0;
+  if (d_max == 0.0) {  // det T itself, certified on T scaled to O(1) (a rare call: the scaling's cost is no matter)
+    int et = 0;
+    std::frexp(t_max, &et);
+    return det_root_detail::positive_up_to<dim>(std::ldexp(1.0, -et) * T, Mat<dim>::Zero(), 1.0) ? inf : 0.0;
+  }
   // Most stencils of a Newton step: dT small against T, cleared to cap
   // without the polynomial (its eight mixed determinants and permanents).
-  // Raw T and dT: scaling them first, or even a range test before the call,
-  // cost the common case 5 ns of its 11 per 2D stencil (perf/bench_det_root).
+  // Raw T and dT: scaling them first took a cleared 2D stencil from 11 to 32
+  // ns, and even a range test before the call cost 5 ns (perf/bench_det_root).
   if (cap < inf && det_root_detail::positive_up_to<dim>(T, dT, cap)) return inf;
   int et = 0, ed = 0;
   std::frexp(t_max, &et), std::frexp(d_max, &ed);

@@ -320,6 +320,26 @@ TYPED_TEST(DetRootTest, CheapClearanceNeverCoversARootAndServesSmallSteps) {
     A << 1, 1, 0, -1, 1, 0, 0, 0, 1;
     B << 1, 1, 0, 1, -1, 0, 0, 0, 0;  // det(A + s B) = 2 (1 + s)(1 - s): s = 1e9 a reaches 0 at a = 1e-9
     expect_root(smallest_positive_det_root<d>(1e100 * A, 1e109 * B, 1.0), 1e-9, 1e-6);
+    // An inverted T (det -1e201) whose cofactor product T(2,1) T(0,2)
+    // overflows while the permanent stays finite: the computed det is +inf.
+    Mat<d> O;
+    O << 1, 1, 1e200, 1e-200, 1, 10, 1, 1e200, 1;
+    EXPECT_FALSE(det_root_detail::positive_up_to<d>(O, Mat<d>::Constant(1e-3), 1.0 / 0.9));
+    EXPECT_EQ(smallest_positive_det_root<d>(O, Mat<d>::Constant(1e-3), 1.0 / 0.9), 0.0);
+    // An inverted T (det -0.48 2^-774) whose cofactor T(1,1) T(2,2) - T(1,2)
+    // T(2,1) is subnormal and rounds to +2^-1073 (true 1.02 2^-1074), then
+    // multiplied by T(0,0) = 2^300: the computed det comes out positive.
+    Mat<d> U = Mat<d>::Zero();
+    U(0, 0) = std::ldexp(1.0, 300);
+    U(1, 1) = std::ldexp(1.0, -537), U(2, 2) = std::ldexp(1.51, -537);
+    U(1, 2) = std::ldexp(1.0, -537), U(2, 1) = std::ldexp(0.49, -537);
+    U(0, 1) = std::ldexp(1.0, -118), U(1, 0) = std::ldexp(0.75 / 1.51, -118);
+    EXPECT_LT(det_ld<d>(U, Mat<d>::Zero(), 0.0L), 0.0L);
+    EXPECT_FALSE(det_root_detail::positive_up_to<d>(U, Mat<d>::Zero(), 1.0));
+    EXPECT_EQ(smallest_positive_det_root<d>(U, Mat<d>::Zero()), 0.0);  // no step: det T's sign alone
+    Mat<d> dU = Mat<d>::Zero();
+    dU(1, 1) = std::ldexp(1.0, -1074);
+    EXPECT_EQ(smallest_positive_det_root<d>(U, dU, std::ldexp(1.0, -260)), 0.0);
   }
   // Not positive, not finite: never cleared.
   EXPECT_FALSE(det_root_detail::positive_up_to<d>(diag<d>(-1, 1, 1), 1e-9 * Mat<d>::Identity(), 1.0));
