@@ -8,6 +8,7 @@
 #include <Tpetra_Vector.hpp>
 #include <algorithm>
 #include <stdexcept>
+#include <utility>
 
 #include "solver/dof_graph.hpp"
 
@@ -135,13 +136,13 @@ void DofSpace<dim>::rebuild(const std::string& cause) {
   count_cause(cause);
   Kokkos::Timer timer;
   if (!distributed()) {
-    A_ = Teuchos::rcp(new Matrix(build_dof_graph<dim>(couplers(), n_nodes_, map_)));
+    A_ = Teuchos::rcp(new Matrix(build_dof_graph<dim>(std::as_const(*this).terms(), n_nodes_, map_)));
     A_->fillComplete();
   } else {
     if (slip_.count() > 0) throw std::invalid_argument("slip constraints run on 1 MPI rank only in this version");
     // Overlap graph (local ids), then the owned graph: each owned row holds the
     // union of its rows on all ranks (row lengths summed first: an upper bound).
-    auto G_ov = build_dof_graph<dim>(couplers(), n_nodes_, overlap_map_, map_);
+    auto G_ov = build_dof_graph<dim>(std::as_const(*this).terms(), n_nodes_, overlap_map_, map_);
     Vector len_ov(overlap_map_), len(map_);
     {
       auto v = len_ov.getLocalViewHost(Tpetra::Access::OverwriteAll);

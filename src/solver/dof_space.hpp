@@ -84,11 +84,9 @@ class DofSpace {
   Teuchos::RCP<const Map> overlap_map() const { return overlap_map_.is_null() ? map_ : overlap_map_; }
   Teuchos::RCP<Matrix> matrix() const { return A_; }
   // The terms; only a non-const DOF space (the Newton solver's) hands them
-  // out to be updated.
+  // out to be updated. The const ones are also what the graph builder sees.
   const std::vector<EnergyTerm<dim>*>& terms() { return terms_; }
   std::vector<const EnergyTerm<dim>*> terms() const { return {terms_.begin(), terms_.end()}; }
-  // The terms as the graph builder sees them (add_couplings only).
-  std::vector<const EnergyTerm<dim>*> couplers() const { return {terms_.begin(), terms_.end()}; }
 
   // Assembly: zero the matrix values, hand out the sink, close.
   void begin_assembly();
