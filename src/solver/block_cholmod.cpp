@@ -65,8 +65,9 @@ struct BlockCholmod::Impl {
 // Once per graph (host): which of A's entries lie in this rank's block, in
 // block coordinates (owned rows by local id, then the ghosts), sorted per row.
 BlockCholmod::BlockCholmod(const Teuchos::RCP<const Matrix>& A, int overlap, bool single) : impl_(new Impl) {
-  if (overlap != 0 && overlap != 1)
-    throw std::invalid_argument("BlockCholmod: overlap " + std::to_string(overlap) + "; expected 0 or 1");
+  if (overlap < 0 || overlap > kMaxOverlap)
+    throw std::invalid_argument("BlockCholmod: overlap " + std::to_string(overlap) + "; expected 0 to " +
+                                std::to_string(kMaxOverlap));
   auto& m = *impl_;
   m.A = A;
   m.want_single = single;
@@ -75,19 +76,42 @@ BlockCholmod::BlockCholmod(const Teuchos::RCP<const Matrix>& A, int overlap, boo
   const auto lcl = A->getLocalMatrixHost();
   const LO invalid = Teuchos::OrdinalTraits<LO>::invalid();
   m.n_own = static_cast<LO>(rows.getNodeNumElements());
-  // Overlap 1: the ghosts are A's columns this rank does not own.
+  // Overlap level 1: the ghosts are A's columns this rank does not own; level
+  // l adds the columns of the level-(l-1) ghosts' rows (imported from their
+  // owners) that are neither owned nor ghosts yet, as Ifpack2's overlapping
+  // row matrix does. Every rank runs the same levels (the imports are collective).
+  const bool any_overlap = overlap > 0 && A->getComm()->getSize() > 1;
+  const auto make_map = [&](const std::vector<GO>& g) {
+    return Teuchos::rcp(new Map(Teuchos::OrdinalTraits<Tpetra::global_size_t>::invalid(),
+                                Teuchos::ArrayView<const GO>(g), 0, A->getComm()));
+  };
   std::vector<GO> ghosts;
-  if (overlap == 1 && A->getComm()->getSize() > 1)
+  if (any_overlap) {
     for (std::size_t k = 0; k < cols.getNodeNumElements(); ++k)
       if (rows.getLocalElement(cols.getGlobalElement(k)) == invalid) ghosts.push_back(cols.getGlobalElement(k));
-  m.ghost_map = Teuchos::rcp(new Map(Teuchos::OrdinalTraits<Tpetra::global_size_t>::invalid(),
-                                     Teuchos::ArrayView<const GO>(ghosts), 0, A->getComm()));
+    std::size_t level_begin = 0;  // the last level's ghosts: ghosts[level_begin..]
+    for (int level = 2; level <= overlap; ++level) {
+      const std::vector<GO> last(ghosts.begin() + static_cast<std::ptrdiff_t>(level_begin), ghosts.end());
+      const auto last_map = make_map(last);
+      Teuchos::RCP<Matrix> outer;
+      A->importAndFillComplete(outer, Tpetra::Import<LO, GO, Node>(A->getRowMap(), last_map), A->getDomainMap(),
+                               A->getRangeMap());
+      std::vector<GO> known(ghosts);
+      std::sort(known.begin(), known.end());
+      std::vector<GO> added;
+      const auto& ocols = *outer->getColMap();
+      for (std::size_t k = 0; k < ocols.getNodeNumElements(); ++k) {
+        const GO g = ocols.getGlobalElement(k);
+        if (rows.getLocalElement(g) == invalid && !std::binary_search(known.begin(), known.end(), g))
+          added.push_back(g);
+      }
+      std::sort(added.begin(), added.end());
+      level_begin = ghosts.size();
+      ghosts.insert(ghosts.end(), added.begin(), added.end());
+    }
+  }
+  m.ghost_map = make_map(ghosts);
   m.n_ghost = static_cast<LO>(ghosts.size());
-  const bool any_overlap = [&] {  // collective: every rank builds the import, or none
-    int mine = overlap == 1 && A->getComm()->getSize() > 1 ? 1 : 0, any = 0;
-    Teuchos::reduceAll(*A->getComm(), Teuchos::REDUCE_MAX, mine, Teuchos::outArg(any));
-    return any != 0;
-  }();
   // Block index of a global DOF (owned: its row id; ghost: n_own + ghost id), or -1.
   auto block_index = [&](GO g) -> LO {
     const LO r = rows.getLocalElement(g);

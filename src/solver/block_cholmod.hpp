@@ -22,6 +22,9 @@
 // ghosts is added into their owners. The overlap carries the coupling across
 // rank boundaries into the local solves, so CG needs fewer iterations than
 // with the plain blocks, at the price of a larger factor and two exchanges.
+// Overlap level L > 1 grows O_p level by level: the DOFs the previous
+// level's rows couple to (Ifpack2's overlap level L). A wider overlap carries
+// more of the coupling (fewer CG iterations) into a larger factor.
 // A_OpOp is still a principal submatrix of A (the indefiniteness proof
 // below holds). On one rank both are M = A.
 //
@@ -39,12 +42,15 @@ namespace bfemp {
 
 class BlockCholmod : public Operator {
  public:
-  // overlap: 0 (block Jacobi on the owned rows) or 1 (see above). single:
+  // overlap: 0 (block Jacobi on the owned rows), 1 (see above) or a higher
+  // level L (the ghosts of level L-1's rows added, Ifpack2's overlap level L).
+  // single:
   // apply() solves with a float copy of the factor in double arithmetic (from
   // the first solve after the factor has served a few, see prepare_solve)
   // (solver/single_factor.hpp: the exact inverse of the rounded factor, so
   // still a fixed symmetric positive definite preconditioner; half the bytes
   // per triangular solve); a simplicial factor keeps CHOLMOD's double solve.
+  static constexpr int kMaxOverlap = 4;
   explicit BlockCholmod(const Teuchos::RCP<const Matrix>& A, int overlap = 0, bool single = false);
   ~BlockCholmod() override;
   BlockCholmod(const BlockCholmod&) = delete;

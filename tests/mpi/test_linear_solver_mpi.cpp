@@ -8,6 +8,7 @@
 #include <Tpetra_Vector.hpp>
 #include <cmath>
 #include <iostream>
+#include <map>
 #include <tuple>
 
 #include "solver/block_cholmod.hpp"
@@ -190,45 +191,59 @@ TEST(LinearSolverMpi, BlockJacobiFactorsEachRanksBlockWithTheValuesOfSolveTime) 
 // SCHWARZ with overlap level 1, combine mode ADD and an exact subdomain solve
 // (KLU2): the same CG iterations. On P ranks the overlap carries the coupling
 // across the cuts into the local solves: fewer iterations than the plain
-// blocks (overlap 0); on one rank M = A (one iteration). A negative diagonal
+// blocks (overlap 0); on one rank M = A (one iteration). Overlap 2 and 3 add
+// the rows the previous level's ghosts couple to: Ifpack2's overlap levels 2
+// and 3 (the same iterations again), and on P ranks no more iterations than
+// the level below, fewer on the badly conditioned matrix. A negative diagonal
 // entry in a row that is a ghost on another rank is found there too.
 TEST(LinearSolverMpi, BlockOverlapOneIsAdditiveSchwarzWithFewerIterations) {
   auto comm = Tpetra::getDefaultComm();
   auto A = laplacian(comm);
   set_values(*A, 0.0, 0.0);
   Teuchos::ParameterList ls = cg_with("BLOCK_CHOLMOD");
-  ls.sublist("CG").set("block overlap", 1);
   ls.sublist("CG").set("block reuse", false);
-  LinearSolver overlap(ls, comm);
   ls.sublist("CG").set("block overlap", 0);
   LinearSolver plain(ls, comm);
-  ls = cg_with("SCHWARZ");
-  auto& ip = ls.sublist("CG").sublist("Ifpack2");
-  ip.set("schwarz: overlap level", 1);
-  ip.set("schwarz: combine mode", std::string("ADD"));
-  ip.set("schwarz: inner preconditioner name", std::string("AMESOS2"));
-  ip.sublist("schwarz: inner preconditioner parameters").set("Amesos2 solver name", std::string("KLU2"));
-  ip.sublist("schwarz: inner preconditioner parameters").sublist("Amesos2");
-  LinearSolver schwarz(ls, comm);
-  for (LinearSolver* s : {&overlap, &plain, &schwarz}) s->set_matrix(A);
-  for (const auto& [diag, off] : {std::pair{4.01, 1.0}, std::pair{6.0, 0.5}}) {
-    set_values(*A, diag, off);
-    const auto [oi, oe] = solve_known(overlap, *A);
-    const auto [pi, pe] = solve_known(plain, *A);
-    const auto [si, se] = solve_known(schwarz, *A);
-    EXPECT_LT(oe, 1e-8) << "overlap 1, diagonal " << diag;
-    EXPECT_LT(se, 1e-8) << "SCHWARZ overlap 1, diagonal " << diag;
-    EXPECT_LE(std::abs(oi - si), 1) << "additive Schwarz twice, diagonal " << diag;
-    if (comm->getSize() == 1) {
-      EXPECT_EQ(oi, 1) << "diagonal " << diag;
-    } else {
-      EXPECT_LT(oi, pi) << "diagonal " << diag;
+  plain.set_matrix(A);
+  std::map<double, int> below;  // per diagonal: the iterations of the level below
+  for (int level = 1; level <= 3; ++level) {
+    ls = cg_with("BLOCK_CHOLMOD");
+    ls.sublist("CG").set("block reuse", false);
+    ls.sublist("CG").set("block overlap", level);
+    LinearSolver overlap(ls, comm);
+    Teuchos::ParameterList sl = cg_with("SCHWARZ");
+    auto& ip = sl.sublist("CG").sublist("Ifpack2");
+    ip.set("schwarz: overlap level", level);
+    ip.set("schwarz: combine mode", std::string("ADD"));
+    ip.set("schwarz: inner preconditioner name", std::string("AMESOS2"));
+    ip.sublist("schwarz: inner preconditioner parameters").set("Amesos2 solver name", std::string("KLU2"));
+    ip.sublist("schwarz: inner preconditioner parameters").sublist("Amesos2");
+    LinearSolver schwarz(sl, comm);
+    for (LinearSolver* s : {&overlap, &schwarz}) s->set_matrix(A);
+    for (const auto& [diag, off] : {std::pair{4.01, 1.0}, std::pair{6.0, 0.5}}) {
+      set_values(*A, diag, off);
+      const auto [oi, oe] = solve_known(overlap, *A);
+      const auto [si, se] = solve_known(schwarz, *A);
+      EXPECT_LT(oe, 1e-8) << "overlap " << level << ", diagonal " << diag;
+      EXPECT_LT(se, 1e-8) << "SCHWARZ overlap " << level << ", diagonal " << diag;
+      EXPECT_LE(std::abs(oi - si), 1) << "additive Schwarz twice, overlap " << level << ", diagonal " << diag;
+      if (comm->getSize() == 1) {
+        EXPECT_EQ(oi, 1) << "overlap " << level << ", diagonal " << diag;
+      } else if (level == 1) {
+        const int pi = solve_known(plain, *A).first;
+        EXPECT_LT(oi, pi) << "diagonal " << diag;
+        std::cout << "diagonal " << diag << ": CG iterations " << pi << " (overlap 0)\n";
+      } else {
+        EXPECT_LE(oi, below[diag]) << "overlap " << level << ", diagonal " << diag;
+        if (diag < 5) EXPECT_LT(oi, below[diag]) << "overlap " << level << ", diagonal " << diag;
+      }
+      below[diag] = oi;
+      std::cout << "diagonal " << diag << ": CG iterations " << oi << " (BLOCK_CHOLMOD overlap " << level << "), "
+                << si << " (SCHWARZ overlap " << level << " + KLU2)\n";
     }
-    std::cout << "diagonal " << diag << ": CG iterations " << oi << " (BLOCK_CHOLMOD overlap 1), " << pi
-              << " (overlap 0), " << si << " (SCHWARZ overlap 1 + KLU2)\n";
+    // The last row of rank 0 is a ghost of rank 1 (the cut): make it indefinite there.
+    expect_indefinite_found(overlap, *A, static_cast<LO>(A->getRowMap()->getNodeNumElements()) - 1);
   }
-  // The last row of rank 0 is a ghost of rank 1 (the cut): make it indefinite there.
-  expect_indefinite_found(overlap, *A, static_cast<LO>(A->getRowMap()->getNodeNumElements()) - 1);
 }
 
 // 'block reuse' (the default): a later solve on the same graph keeps the
