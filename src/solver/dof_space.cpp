@@ -141,27 +141,13 @@ void DofSpace<dim>::rebuild(const std::string& cause) {
   } else {
     if (slip_.count() > 0) throw std::invalid_argument("slip constraints run on 1 MPI rank only in this version");
     // Overlap graph (local ids), then the owned graph: each owned row holds the
-    // union of its rows on all ranks (row lengths summed first: an upper bound).
+    // union of its rows on all ranks (built with the value-sum plan).
     auto G_ov = build_dof_graph<dim>(std::as_const(*this).terms(), n_nodes_, overlap_map_, map_);
-    Vector len_ov(overlap_map_), len(map_);
-    {
-      auto v = len_ov.getLocalViewHost(Tpetra::Access::OverwriteAll);
-      for (LO i = 0; i < static_cast<LO>(v.extent(0)); ++i) v(i, 0) = static_cast<double>(G_ov->getNumEntriesInLocalRow(i));
-    }
-    len.doExport(len_ov, *export_, Tpetra::ADD);
-    std::vector<std::size_t> cap(map_->getNodeNumElements());
-    {
-      auto v = len.getLocalViewHost(Tpetra::Access::ReadOnly);
-      for (std::size_t i = 0; i < cap.size(); ++i) cap[i] = static_cast<std::size_t>(v(i, 0) + 0.5);
-    }
-    auto G = Teuchos::rcp(new Graph(map_, Teuchos::ArrayView<const std::size_t>(cap)));
-    G->doExport(*G_ov, *export_, Tpetra::INSERT);
-    G->fillComplete(map_, map_);
+    matrix_sum_ = std::make_unique<OverlapMatrixSum>(*G_ov, *export_);
     A_overlap_ = Teuchos::rcp(new Matrix(G_ov));
     A_overlap_->fillComplete(map_, map_);
-    A_ = Teuchos::rcp(new Matrix(Teuchos::RCP<const Graph>(G)));
+    A_ = Teuchos::rcp(new Matrix(matrix_sum_->graph()));
     A_->fillComplete(map_, map_);
-    matrix_sum_ = std::make_unique<OverlapMatrixSum>(*A_overlap_, *A_, *export_);
     const LO n_own = static_cast<LO>(map_->getNodeNumElements());
     diag_col_ = Kokkos::View<LO*, MemSpace>("dof_diag_col", n_own);
     auto dh = Kokkos::create_mirror_view(diag_col_);
