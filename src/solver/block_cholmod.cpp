@@ -37,7 +37,7 @@ struct BlockCholmod::Impl {
   SingleFactor single;  // the factor in float (want_single), copied by prepare_solve() once worth it
   int applies = 0;      // apply() calls since the factorisation
   double fl = 0, lnz = 0;  // CHOLMOD's analysis: factorisation flops, nonzeros of L
-  // Overlap 1 (n_ghost > 0): the ghost rows (imported from their owners into
+  // Overlap >= 1 (n_ghost > 0): the ghost rows (imported from their owners into
   // a matrix on ghost_map with a fixed graph), the block's entries from them
   // (after the owned rows' n_from_A entries), and the vectors of apply().
   LO n_own = 0, n_ghost = 0;
@@ -308,6 +308,10 @@ double BlockCholmod::iteration_flops() const {
 std::size_t BlockCholmod::block_rows() const { return impl_->p.size() - 1; }
 std::size_t BlockCholmod::block_entries() const { return impl_->i.size(); }
 bool BlockCholmod::applies_single() const { return impl_->single.ready(); }
+bool BlockCholmod::supernodal() const {
+  const auto& m = *impl_;
+  return m.p.size() <= 1 || (m.L != nullptr && m.L->is_super);
+}
 
 void BlockCholmod::new_step() { impl_->single.new_step(); }
 

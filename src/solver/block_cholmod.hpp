@@ -24,7 +24,9 @@
 // with the plain blocks, at the price of a larger factor and two exchanges.
 // Overlap level L > 1 grows O_p level by level: the DOFs the previous
 // level's rows couple to (Ifpack2's overlap level L). A wider overlap carries
-// more of the coupling (fewer CG iterations) into a larger factor.
+// more of the coupling into a larger factor: fewer CG iterations with a
+// fresh factor; with a stale one (block reuse) the iterations may not fall
+// (paper twist: perf/README, "The 2-rank block factor").
 // A_OpOp is still a principal submatrix of A (the indefiniteness proof
 // below holds). On one rank both are M = A.
 //
@@ -73,8 +75,11 @@ class BlockCholmod : public Operator {
   // product with A's local rows, 2 nnz). Deterministic, unlike timings.
   double factor_flops() const;
   double iteration_flops() const;
+  // The factor is supernodal (CHOLMOD's choice; dense BLAS 3 on its
+  // supernodes), or this rank's block is empty. False before a compute().
+  bool supernodal() const;
 
-  // This rank's block: rows (owned, plus ghosts with overlap 1) and stored
+  // This rank's block: rows (owned, plus ghosts with overlap >= 1) and stored
   // entries (both triangles).
   std::size_t block_rows() const;
   std::size_t block_entries() const;

@@ -455,8 +455,9 @@ LinearSolveStats LinearSolver::solve(const Vector& b, Vector& x, double forcing,
     // Ski rental: refactorise once the extra CG iterations on the stale
     // factor have cost as much as a factorisation. A factorisation's flops
     // are priced kBlas3Advantage times cheaper than a CG iteration's (dense
-    // BLAS 3 against memory-bound triangular solves), as Cholmod's reuse
-    // budget does (cholmod_direct.hpp). Paper twist, 2 ranks x 1 thread:
+    // BLAS 3 against memory-bound triangular solves) when every rank's
+    // factor is supernodal, as Cholmod's reuse budget does for a supernodal
+    // factor (cholmod_direct.hpp; a simplicial one has no BLAS 3). Paper twist, 2 ranks x 1 thread:
     // without that factor 2.4 factorisations and 668 CG iterations per step,
     // 11.7 s of solve; with it 3.4 and 482, 10.6 s (perf/README).
     const bool fresh = !m.block_reuse || !m.block_valid || m.block_excess_its >= m.block_fact_its;
@@ -464,10 +465,12 @@ LinearSolveStats LinearSolver::solve(const Vector& b, Vector& x, double forcing,
       m.block_valid = false;
       m.block->compute();  // throws NotPositiveDefinite on every rank if a block is indefinite
       {  // the costliest rank's factorisation, in its CG iterations (every rank decides alike)
-        const double mine[2] = {m.block->factor_flops(), m.block->iteration_flops()};
-        double most[2] = {0, 0};
-        Teuchos::reduceAll(*m.comm, Teuchos::REDUCE_MAX, 2, mine, most);
-        m.block_fact_its = most[1] > 0 ? most[0] / (CholmodReuse::kBlas3Advantage * most[1]) : 0.0;
+        const double mine[3] = {m.block->factor_flops(), m.block->iteration_flops(),
+                                m.block->supernodal() ? 0.0 : 1.0};
+        double most[3] = {0, 0, 0};
+        Teuchos::reduceAll(*m.comm, Teuchos::REDUCE_MAX, 3, mine, most);
+        const double price = most[2] == 0.0 ? CholmodReuse::kBlas3Advantage : 1.0;
+        m.block_fact_its = most[1] > 0 ? most[0] / (price * most[1]) : 0.0;
       }
       m.block_valid = true;
       m.block_excess_its = 0;

@@ -70,13 +70,26 @@ OverlapMatrixSum::OverlapMatrixSum(const Graph& G_ov, const Tpetra::Export<LO, G
     }
   }
   std::string error;
+  // Each value travels as 3 keys, and MPI's counts and displacements are
+  // int: a rank's sent and received values must each total at most kMax
+  // (checked on every rank before the exchange; all throw together).
+  const std::size_t kMax = static_cast<std::size_t>(std::numeric_limits<int>::max() / 3);
   std::vector<int> scount(nranks), rcount(nranks), sdisp(nranks + 1, 0), rdisp(nranks + 1, 0);
+  std::size_t sent_total = 0, received_total = 0;
   for (int p = 0; p < nranks; ++p) {
-    if (src[p].size() > static_cast<std::size_t>(std::numeric_limits<int>::max() / 3))
-      error = "OverlapMatrixSum: more than 2^29 values for one rank (MPI counts are int)";
-    scount[p] = static_cast<int>(std::min(src[p].size(), static_cast<std::size_t>(std::numeric_limits<int>::max() / 3)));
+    sent_total += src[p].size();
+    scount[p] = static_cast<int>(std::min(src[p].size(), kMax));
   }
   MPI_Alltoall(scount.data(), 1, MPI_INT, rcount.data(), 1, MPI_INT, comm_);
+  for (int p = 0; p < nranks; ++p) received_total += static_cast<std::size_t>(rcount[p]);
+  {
+    int big = sent_total > kMax || received_total > kMax ? 1 : 0, any_big = 0;
+    MPI_Allreduce(&big, &any_big, 1, MPI_INT, MPI_MAX, comm_);
+    if (any_big)
+      throw std::length_error("OverlapMatrixSum: a rank sends or receives more than " + std::to_string(kMax) +
+                              " matrix values (this rank: " + std::to_string(sent_total) + " sent, " +
+                              std::to_string(received_total) + " received; MPI counts are int)");
+  }
   std::vector<LO> ssrc;
   std::vector<long long> skeys;
   send_offsets_.assign(1, 0);
@@ -121,7 +134,8 @@ OverlapMatrixSum::OverlapMatrixSum(const Graph& G_ov, const Tpetra::Export<LO, G
   remote.erase(std::unique(remote.begin(), remote.end()), remote.end());
   const auto remote_col = [&](int p, GO g) {
     const auto it = std::lower_bound(remote.begin(), remote.end(), std::make_pair(p, g));
-    return static_cast<LO>(n_own + (it - remote.begin()));
+    return it != remote.end() && *it == std::make_pair(p, g) ? static_cast<LO>(n_own + (it - remote.begin()))
+                                                             : invalid;
   };
   std::vector<LO> col_of(n_ov);  // A's local column of each overlap column
   for (LO i = 0; i < n_ov; ++i)

@@ -26,7 +26,9 @@
 // same Map object as its row map (build_dof_graph); the Export goes from
 // that map to the owned one-to-one map (A's row, domain and range map); A is
 // made from graph() and is fill-active when sum() is called. Construction is
-// collective (host work and one all-to-all of counts); so is sum().
+// collective (host work; an all-to-all of counts and one of the keys, two
+// all-reduces, the column Map and the graph's fillComplete, which builds its
+// Import); so is sum().
 #include <Tpetra_Export_decl.hpp>
 #include <mpi.h>
 #include <vector>
