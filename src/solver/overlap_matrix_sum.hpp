@@ -16,7 +16,9 @@
 // The plan also builds A's graph: each owned row holds the union of that
 // row's columns on every rank (this rank's overlap row, and the ghost rows
 // the other ranks send), its column map the owned DOFs first (in row order),
-// then the others sorted by owning rank and id, as Tpetra orders one. This
+// then the others sorted by owning rank and id (Tpetra groups its remote
+// columns by rank too, but within a rank not always by id: the same set,
+// possibly in another order; tests/mpi/test_overlap_matrix_sum.cpp). This
 // replaces an Export of the overlap graph with INSERT (plus its
 // fillComplete), which inserted every entry by global id: 0.4-0.7 s per
 // graph on the paper twist at 2 ranks. Each column's owner comes with it
