@@ -146,6 +146,11 @@
 // ("~16 in 2D": particles whose centres lie in the 4 cells around the node)
 // instead of the uGIMP support's ~25: 3.6 % at 0.5 %, 7.7 % at 12 %: the block-
 // edge nodes (x = -5, 45 mm) then have no cloud and no contact. Not kept.
+// (4) Grip 5 with the non-paper knobs, USAVG: penalty 1e-3 dx^2: <= 0.01 %
+// to 7.5 %, a 0.62 % spike at 7.7 %, 0.1-0.25 % to 14 %, < 0.06 % after;
+// penalty 1e-3 and d_LR tolerance 1e-3 dx: <= 0.07 % to 14 %, a 0.40 % spike
+// at 14.7 %, 0.14-0.24 % after. The grip removes the crossing spike (grip 0:
+// 0.89 % at 5.2 %), the spikes move elsewhere.
 #ifndef B1_END_STRAIN
 #define B1_END_STRAIN 0.20
 #endif
