@@ -343,6 +343,16 @@ RunSummary run_dim(const Scene& scene, const std::string& dir, const Teuchos::RC
     s.output_s = most[2];
     s.exchange_mb = most[3];
     s.graph_build_s = most[4];
+    // Each rank's own work: the spread shows a load imbalance that counts of
+    // particles, elements and DOFs do not (contact pairs, factor fill).
+    const double work[2] = {s.assembly_s - sim.newton().dof_space().sum_seconds(), s.factor_s};
+    double lo[2], hi[2], sum[2];
+    Teuchos::reduceAll(*comm, Teuchos::REDUCE_MIN, 2, work, lo);
+    Teuchos::reduceAll(*comm, Teuchos::REDUCE_MAX, 2, work, hi);
+    Teuchos::reduceAll(*comm, Teuchos::REDUCE_SUM, 2, work, sum);
+    const double n = comm->getSize();
+    s.rank_assembly_s = {lo[0], hi[0], sum[0] / n};
+    s.rank_factor_s = {lo[1], hi[1], sum[1] / n};
   }
   if (const auto* mpm = sim.mpm()) {
     s.particle_sorts = mpm->particle_sorts();
@@ -435,9 +445,12 @@ RunSummary run_scene(const Scene& scene, const std::string& dir, const Teuchos::
         << " Newton iterations (the others: CG on the previous factor)"
         << (s.stale_retries > 0 ? "; " + std::to_string(s.stale_retries) + " solve(s) redone on a fresh factor" : std::string())
         << "\n";
-  if (s.factor_s + s.reuse_cg_s > 0)
-    log << "    of the solve time " << s.factor_s << " s analysis + factorisation, " << s.reuse_cg_s << " s in "
-        << s.reuse_cg_iterations << " CG iterations on the previous factor\n";
+  if (s.factor_s + s.reuse_cg_s > 0) {
+    log << "    of the solve time " << s.factor_s << " s analysis + factorisation" << (s.ranks > 1 ? " (rank 0's)" : "");
+    if (s.reuse_cg_iterations > 0)
+      log << ", " << s.reuse_cg_s << " s in " << s.reuse_cg_iterations << " CG iterations on the previous factor";
+    log << "\n";
+  }
   if (s.exact_hessian_iterations + s.projection_fallbacks > 0)
     log << "  exact Hessian       " << s.exact_hessian_iterations << " of " << s.newton_iterations
         << " iterations (" << s.projection_fallbacks << " not positive definite: projected";
@@ -465,6 +478,22 @@ RunSummary run_scene(const Scene& scene, const std::string& dir, const Teuchos::
     log << "  MPM on " << s.mpm_ranks << " ranks      " << s.migrations << " particle migrations, " << s.rebalances
         << " slab rebalance(s); particle imbalance at the end " << std::setprecision(3) << s.imbalance
         << " (largest / mean per rank)\n";
+  if (s.ranks > 1) {
+    const auto digits = log.precision();
+    auto spread = [&](const RunSummary::Spread& w) {
+      log << std::setprecision(4) << w.min << ".." << w.max << " s (max / mean " << std::setprecision(3)
+          << (w.mean > 0 ? w.max / w.mean : 1.0) << ")";
+    };
+    log << "  work per rank       assembly ";
+    spread(s.rank_assembly_s);
+    log << " (its DOF sums, where ranks wait, excluded)";
+    if (s.rank_factor_s.max > 0) {
+      log << ", factorisations ";
+      spread(s.rank_factor_s);
+    }
+    log << "\n";
+    log.precision(digits);
+  }
   if (comm->getSize() > 1)
     log << "  MPI exchanges       " << s.exchange_s << " s DOF export/import (within the times above; "
         << s.exchange_mb << " MB sent), " << s.migration_s

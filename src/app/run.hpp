@@ -35,7 +35,12 @@ struct RunSummary {
   long graph_builds = 0, symbolic_factorizations = 0, numeric_factorizations = 0;
   long scatter_tables = 0;  // DofSpace scatter tables built (rank 0's), and their seconds
   double scatter_table_s = 0;
-  double factor_s = 0, reuse_cg_s = 0;  // Cholmod (within solve_s)
+  double factor_s = 0, reuse_cg_s = 0;  // Cholmod, BLOCK_CHOLMOD's factorisations (within solve_s; rank 0's)
+  // MPI: the spread over the ranks of each rank's own work, in seconds.
+  struct Spread {
+    double min = 0, max = 0, mean = 0;
+  };
+  Spread rank_assembly_s, rank_factor_s;  // assembly (less DofSpace::sum_seconds); factorisations
   long reuse_cg_iterations = 0;
   long stale_retries = 0;  // CG + BLOCK_CHOLMOD solves redone after the kept factor failed
   std::vector<std::pair<std::string, long>> graph_build_causes;  // DofSpace::build_causes (rank 0's)

@@ -7,7 +7,8 @@
 // MPI (distribute() on more than one rank): each rank holds the particles of
 // its slab (mpm/particle_distribution.hpp) and activates the grid nodes its
 // particles touch. A grid node touched by several ranks is owned by one of
-// them (Tpetra::createOneToOne) and a ghost on the others; the active nodes
+// them (Tpetra::createOneToOne; the rank whose slab holds the node's position
+// when it holds the node) and a ghost on the others; the active nodes
 // are numbered owned first, then ghosts (the order DofSpace::set_partition
 // expects), and P2G's partial sums at shared nodes are added at the owner
 // (Export, ADD) and copied back to every holder (Import), so every rank sees
@@ -202,6 +203,7 @@ class MpmBodies {
   bool distributed_ = false;
   GO global_first_ = 0;
   ParticleSlabs<dim> slabs_;
+  std::vector<double> slab_cuts_host_;  // slabs_.cuts on the host, for the node owners' tie-break
   Kokkos::View<long long*, MemSpace> ids_;
   long long n_total_ = 0, migrated_ = 0;
   bool sorted_ = false;  // reordered by cell since construction or replace_particles
@@ -219,6 +221,7 @@ class MpmBodies {
   void resize_stencils();
   void check_inside_grid(long step);
   void number_owned_first(LO first);
+  void set_slabs(const ParticleSlabs<dim>& s);  // slabs_ and its host copy of the cuts
   void sum_shared_nodes();
   double all(double v, Teuchos::EReductionType op) const;  // over the ranks (distributed)
 };

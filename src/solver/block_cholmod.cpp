@@ -37,6 +37,7 @@ struct BlockCholmod::Impl {
   SingleFactor single;  // the factor in float (want_single), copied by prepare_solve() once worth it
   int applies = 0;      // apply() calls since the factorisation
   double fl = 0, lnz = 0;  // CHOLMOD's analysis: factorisation flops, nonzeros of L
+  double local_s = 0;      // compute()'s local work on this rank, summed (no ghost import, no reduction)
   // Overlap >= 1 (n_ghost > 0): the ghost rows (imported from their owners into
   // a matrix on ghost_map with a fixed graph), the block's entries from them
   // (after the owned rows' n_from_A entries), and the vectors of apply().
@@ -209,6 +210,7 @@ void BlockCholmod::compute() {
   m.factored = false;
   m.single.forget();
   {
+    Kokkos::Timer local;
     CholmodSerialScope serial;
     if (!m.analysed && S.nrow > 0) {
       m.L = cholmod_l_analyze(&S, &m.c);
@@ -221,6 +223,7 @@ void BlockCholmod::compute() {
       if (!cholmod_l_factorize(&S, m.L, &m.c)) status = m.c.status == CHOLMOD_OK ? CHOLMOD_INVALID : m.c.status;
       else status = m.c.status;
     }
+    m.local_s += local.seconds();
   }
   // Every rank learns of a failure on any rank (a CG on the others would wait).
   int worst_local = status == CHOLMOD_OK ? 0 : (status == CHOLMOD_NOT_POSDEF ? 1 : 2);
@@ -302,6 +305,7 @@ void BlockCholmod::apply(const MultiVec& Xin, MultiVec& Yout, Teuchos::ETransp, 
 Teuchos::RCP<const Map> BlockCholmod::getDomainMap() const { return impl_->A->getDomainMap(); }
 Teuchos::RCP<const Map> BlockCholmod::getRangeMap() const { return impl_->A->getRangeMap(); }
 double BlockCholmod::factor_flops() const { return impl_->fl; }
+double BlockCholmod::local_factor_seconds() const { return impl_->local_s; }
 double BlockCholmod::iteration_flops() const {
   return 4.0 * impl_->lnz + 2.0 * static_cast<double>(impl_->A->getNodeNumEntries());
 }

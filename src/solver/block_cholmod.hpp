@@ -75,6 +75,10 @@ class BlockCholmod : public Operator {
   // product with A's local rows, 2 nnz). Deterministic, unlike timings.
   double factor_flops() const;
   double iteration_flops() const;
+  // Seconds of this rank's symbolic analyses and numeric factorisations in
+  // all compute() calls so far (its own work: the ghost rows' import and the
+  // failure reduction, where a rank waits for the others, are not in it).
+  double local_factor_seconds() const;
   // The factor is supernodal (CHOLMOD's choice; dense BLAS 3 on its
   // supernodes), or this rank's block is empty. False before a compute().
   bool supernodal() const;

@@ -463,7 +463,9 @@ LinearSolveStats LinearSolver::solve(const Vector& b, Vector& x, double forcing,
     const bool fresh = !m.block_reuse || !m.block_valid || m.block_excess_its >= m.block_fact_its;
     if (fresh) {
       m.block_valid = false;
+      const double before = m.block->local_factor_seconds();
       m.block->compute();  // throws NotPositiveDefinite on every rank if a block is indefinite
+      stats.factor_s = m.block->local_factor_seconds() - before;
       {  // the costliest rank's factorisation, in its CG iterations (every rank decides alike)
         const double mine[3] = {m.block->factor_flops(), m.block->iteration_flops(),
                                 m.block->supernodal() ? 0.0 : 1.0};

@@ -22,7 +22,7 @@ struct LinearSolveStats {
   bool factorised = false;   // a numeric factorisation happened in this call (direct solvers)
   double tolerance = 0;      // relative residual the solve was asked for (0: exact, a factorisation's;
                              // Cholmod's CG on the previous factor: the tolerance it stopped at)
-  double factor_s = 0;       // Cholmod: seconds in analysis + numeric factorisation
+  double factor_s = 0;       // Cholmod, BLOCK_CHOLMOD (this rank's block): seconds in analysis + numeric factorisation
   double reuse_cg_s = 0;     // Cholmod: seconds in CG on the previous factor
   int reuse_cg_iterations = 0;  // Cholmod: CG iterations on the previous factor
   int stale_retries = 0;     // CG + BLOCK_CHOLMOD: solves that did not converge on the

@@ -80,7 +80,7 @@ struct NewtonStats {
   int graph_builds = 0;            // graph rebuilds inside the solve (contact pairs outside the graph)
   int symbolic_factorizations = 0; // direct solvers: symbolic phases run
   int numeric_factorizations = 0;  // direct solvers: numeric factorisations run (failed ones too)
-  double factor_s = 0, reuse_cg_s = 0;  // Cholmod: within solve_s (successful solves)
+  double factor_s = 0, reuse_cg_s = 0;  // Cholmod (factor_s also BLOCK_CHOLMOD, this rank's): within solve_s (successful solves)
   int reuse_cg_iterations = 0;          // Cholmod: CG iterations on the previous factor
   int stale_retries = 0;           // CG + BLOCK_CHOLMOD: solves redone on a fresh factor after the kept one failed
   int projected_retries = 0;       // the step failed with the exact Hessian and was redone projected

@@ -146,6 +146,51 @@ TEST(MpmMpi, BlockHittingABlockAcrossTheCutEqualsOneRank) {
   }
 }
 
+// A grid node that several ranks hold is owned by the rank whose slab holds
+// its position: one block across the cut(s), after a step, on every rank an
+// active node is owned exactly when its position lies in the rank's slab.
+// (Tpetra's default, the lowest holder, gives every shared node to the lower
+// rank of a cut: 9 nodes on the wrong side here at 2 ranks.) The run still
+// equals one rank.
+TEST(MpmMpi, SharedGridNodesAreOwnedOnTheirSideOfTheCut) {
+  auto world = Tpetra::getDefaultComm();
+  Teuchos::RCP<const Comm> self = Teuchos::rcp(new Teuchos::MpiComm<int>(MPI_COMM_SELF));
+  auto setup = [] {
+    auto s = fixtures::mpm_rect_setup(1.2, 0.3, Vec<2>(1.2, 0.4), 0.05, 4, Vec<2>(0.0, 0.0), Vec<2>(2.4, 0.8),
+                                      TransferScheme::APIC);
+    set_velocity<2>(s.mpm->particles, 0, s.mpm->particles.size(), Vec<2>(0.5, -0.2));
+    s.dt = 5e-3;
+    s.integrator = TimeIntegrator::backward_euler();
+    s.linear_solver.set("type", std::string("CG"));
+    s.linear_solver.sublist("CG").set("tolerance", 1e-13);
+    s.newton.eps_d = 1e-9;
+    return s;
+  };
+  Simulation<2> dist(setup(), world);
+  const Result d = run_steps(dist, 3);
+  const auto& mpm = *dist.mpm();
+  const auto& grid = mpm.grid();
+  auto cuts = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), mpm.slabs().cuts);
+  const int axis = mpm.slabs().axis, rank = world->getRank();
+  long wrong = 0, shared_owned = 0;
+  const auto& g = mpm.global_nodes();  // owned first, then ghosts; no FEM nodes before them (empty on 1 rank)
+  if (world->getSize() > 1) ASSERT_EQ(static_cast<LO>(g.size()), mpm.active_nodes());
+  for (std::size_t k = 0; k < g.size(); ++k) {
+    const double c = grid.node_position(static_cast<LO>(g[k]))(axis);
+    int side = 0;
+    while (side < static_cast<int>(cuts.extent(0)) && c >= cuts(side)) ++side;
+    const bool owned = static_cast<LO>(k) < mpm.owned_nodes();
+    if (owned != (side == rank)) ++wrong;
+    if (owned && std::abs(c - (side > 0 ? cuts(side - 1) : -1e9)) < 2 * grid.dx) ++shared_owned;
+  }
+  EXPECT_EQ(wrong, 0) << "rank " << rank << ": active nodes owned against their side of the cut";
+  if (world->getSize() > 1 && rank > 0)
+    EXPECT_GT(shared_owned, 0) << "rank " << rank << " owns no node just above its lower cut: the test tests nothing";
+  Simulation<2> alone(setup(), self);
+  const Result s = run_steps(alone, 3);
+  compare<2>(*world, d, s, 1e-9, "2D block across the cut");
+}
+
 TEST(MpmMpi, CubeThrownAcrossTheCutEqualsOneRank3D) {
   auto world = Tpetra::getDefaultComm();
   Teuchos::RCP<const Comm> self = Teuchos::rcp(new Teuchos::MpiComm<int>(MPI_COMM_SELF));
