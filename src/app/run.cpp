@@ -486,7 +486,7 @@ RunSummary run_scene(const Scene& scene, const std::string& dir, const Teuchos::
     };
     log << "  work per rank       assembly ";
     spread(s.rank_assembly_s);
-    log << " (its DOF sums, where ranks wait, excluded)";
+    log << " (less its DOF sums; waits in the assembly's other collectives remain)";
     if (s.rank_factor_s.max > 0) {
       log << ", factorisations ";
       spread(s.rank_factor_s);

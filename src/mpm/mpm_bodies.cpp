@@ -317,7 +317,7 @@ namespace {
 
 // The owner of a grid node that several ranks hold: the rank whose slab
 // holds the node's position, or, when that rank does not hold the node, the
-// holder whose slab is nearest (then the lower rank). Each rank then owns the
+// holder nearest to it in rank number, i.e. in slab order (then the lower). Each rank then owns the
 // nodes on its side of a cut, so the ranks' parts of the system mirror each
 // other across a cut. With the lowest holder (Tpetra's default) the lower
 // rank of a cut owned every shared node: on the 3D twist at the ci size the
@@ -331,6 +331,7 @@ struct SlabOwner : Tpetra::Details::TieBreak<LO, GO> {
   int axis = 0;
   const std::vector<double>* cuts = nullptr;
   GO first = 0;
+  bool mayHaveSideEffects() const override { return false; }
   std::size_t selectedIndex(GO gid, const std::vector<std::pair<int, LO>>& holders) const override {
     const double c = grid.node_position(static_cast<LO>(gid - first))(axis);
     int want = 0;

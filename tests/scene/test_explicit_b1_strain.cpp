@@ -181,9 +181,12 @@ History run(bool two, XNormals nm, XSeparation sep, XUpdate up, int passes, cons
                  : l == "frictionless" ? xmpm::ContactLaw::Frictionless : xmpm::ContactLaw::Coulomb;
   }
   ExplicitSetup<2> s = tb.setup();
-  if (std::getenv("BFEMP_B1_SLIP"))  // diagnostics: 1 = both walls slip (rollers), 2 = bottom only
+  if (const char* sl = std::getenv("BFEMP_B1_SLIP")) {  // diagnostics: 1 = both walls slip (rollers), 2 = bottom only
+    const std::string w = sl;
+    if (w != "1" && w != "2") throw std::invalid_argument("BFEMP_B1_SLIP = '" + w + "': expected 1 or 2");
     for (auto& l : s.level_sets)
-      if (std::atoi(std::getenv("BFEMP_B1_SLIP")) == 1 || l.name == "bottom") l.slip = true;
+      if (w == "1" || l.name == "bottom") l.slip = true;
+  }
   s.strain_update = su;
   s.normals = nm;
   s.separation = sep;
