@@ -220,11 +220,8 @@ RunSummary run_dim(const Scene& scene, const std::string& dir, const Teuchos::RC
     Teuchos::reduceAll(*comm, Teuchos::REDUCE_MAX, mine, Teuchos::outArg(hi));
     Teuchos::reduceAll(*comm, Teuchos::REDUCE_SUM, mine, Teuchos::outArg(sum));
     const int n = comm->getSize();
-    auto cuts = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), mpm->slabs().cuts);
-    std::ostringstream c;
-    for (std::size_t k = 0; k < cuts.extent(0); ++k) c << (k ? ", " : "") << cuts(k);
-    log << "MPI: " << n << " ranks (MPM particles in slabs along axis " << mpm->slabs().axis << ", cuts at " << c.str()
-        << " m; particles migrate between slabs): particles per rank " << lo << ".." << hi << " (imbalance "
+    log << "MPI: " << n << " ranks (MPM particles in " << describe_boxes(mpm->boxes())
+        << "; particles migrate between them): particles per rank " << lo << ".." << hi << " (imbalance "
         << std::setprecision(3) << hi / (sum / n) << ")\n" << std::setprecision(6);
   }
   {

@@ -164,8 +164,8 @@ void MpmBodies<dim>::replace_particles(const Particles<dim>& all) {
     resize_stencils();
     return;
   }
-  set_slabs(balanced_slabs(all, setup_.grid, comm_->getSize()));
-  setup_.particles = select_slab(all, slabs_, comm_->getRank(), ids_);
+  set_boxes(balanced_boxes(all, setup_.grid, comm_->getSize()));
+  setup_.particles = select_box(all, boxes_, comm_->getRank(), ids_);
   resize_stencils();
 }
 
@@ -195,7 +195,7 @@ long long MpmBodies<dim>::migrate() {
   if (!distributed_) return 0;
   Kokkos::Timer timer;
   long long largest = 0;
-  long long moved = migrate_particles(setup_.particles, ids_, slabs_, *comm_, largest);
+  long long moved = migrate_particles(setup_.particles, ids_, boxes_, *comm_, largest);
   moved += rebalance(largest);
   if (moved > 0) resize_stencils();
   migrated_ += moved;
@@ -212,16 +212,16 @@ long long MpmBodies<dim>::rebalance(long long largest_count) {
   if (imbalance_ <= above) retry_above_ = 0.0;  // balanced again: the next excess may be splittable
   if (!(above > 0) || imbalance_ <= above || imbalance_ <= retry_above_) return 0;
   long long new_largest = 0;
-  ParticleSlabs<dim> s = rebalanced_slabs(setup_.particles, slabs_, setup_.grid, *comm_, new_largest);
+  RankBoxes<dim> s = rebalanced_boxes(setup_.particles, boxes_, setup_.grid, *comm_, new_largest);
   if (static_cast<double>(new_largest) > 0.95 * largest) {  // a cell layer too crowded to split better
     retry_above_ = 1.05 * imbalance_;
     return 0;
   }
-  set_slabs(s);
+  set_boxes(s);
   retry_above_ = 0.0;
   ++rebalances_;
   long long after = 0;
-  const long long moved = migrate_particles(setup_.particles, ids_, slabs_, *comm_, after);
+  const long long moved = migrate_particles(setup_.particles, ids_, boxes_, *comm_, after);
   imbalance_ = mean > 0 ? static_cast<double>(after) / mean : 1.0;
   return moved;
 }
@@ -307,38 +307,36 @@ void MpmBodies<dim>::check_inside_grid(long step) {
 }
 
 template <int dim>
-void MpmBodies<dim>::set_slabs(const ParticleSlabs<dim>& s) {
-  slabs_ = s;
-  auto h = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), s.cuts);
-  slab_cuts_host_.assign(h.data(), h.data() + h.extent(0));
+void MpmBodies<dim>::set_boxes(const RankBoxes<dim>& b) {
+  boxes_ = b;
+  boxes_host_ = b.mirror();
 }
 
 namespace {
 
-// The owner of a grid node that several ranks hold: the rank whose slab
+// The owner of a grid node that several ranks hold: the rank whose box
 // holds the node's position, or, when that rank does not hold the node, the
-// holder nearest to it in rank number, i.e. in slab order (then the lower). Each rank then owns the
-// nodes on its side of a cut, so the ranks' parts of the system mirror each
-// other across a cut. With the lowest holder (Tpetra's default) the lower
-// rank of a cut owned every shared node: on the 3D twist at the ci size the
-// two ranks' BLOCK_CHOLMOD blocks had 3800 and 4500 rows and 0.55e9 and
-// 1.45e9 factorisation flops (this rule: 4100 / 4200 rows, 0.78e9 / 1.13e9);
-// on the paper-size twist the DOF exchanges sent 442 MB instead of 702 in
-// 5 steps (perf/README).
+// holder whose box is nearest to it in the layout (RankBoxes::distance; for
+// slabs, in slab order), then the lower rank. Each rank then owns the nodes
+// on its side of a cut, so the ranks' parts of the system mirror each other
+// across a cut. With the lowest holder (Tpetra's default) the lower rank of
+// a cut owned every shared node: on the 3D twist at the ci size the two
+// ranks' BLOCK_CHOLMOD blocks had 3800 and 4500 rows and 0.55e9 and 1.45e9
+// factorisation flops (this rule: 4100 / 4200 rows, 0.78e9 / 1.13e9); on the
+// paper-size twist the DOF exchanges sent 442 MB instead of 702 in 5 steps
+// (perf/README).
 template <int dim>
-struct SlabOwner : Tpetra::Details::TieBreak<LO, GO> {
+struct BoxOwner : Tpetra::Details::TieBreak<LO, GO> {
   GridSpec<dim> grid;
-  int axis = 0;
-  const std::vector<double>* cuts = nullptr;
+  const RankBoxes<dim, Kokkos::HostSpace>* boxes = nullptr;
   GO first = 0;
   bool mayHaveSideEffects() const override { return false; }
   std::size_t selectedIndex(GO gid, const std::vector<std::pair<int, LO>>& holders) const override {
-    const double c = grid.node_position(static_cast<LO>(gid - first))(axis);
-    int want = 0;
-    while (want < static_cast<int>(cuts->size()) && c >= (*cuts)[want]) ++want;
+    const Vec<dim> c = grid.node_position(static_cast<LO>(gid - first));
+    const int want = boxes->owner(c);
     std::size_t best = 0;
     for (std::size_t k = 1; k < holders.size(); ++k) {
-      const int dk = std::abs(holders[k].first - want), db = std::abs(holders[best].first - want);
+      const int dk = boxes->distance(holders[k].first, want), db = boxes->distance(holders[best].first, want);
       if (dk < db || (dk == db && holders[k].first < holders[best].first)) best = k;
     }
     return best;
@@ -358,10 +356,9 @@ void MpmBodies<dim>::number_owned_first(LO first) {
   std::vector<GO> gids(active_);
   for (LO k = 0; k < active_; ++k) gids[k] = global_first_ + gn(k);
   auto overlap0 = Teuchos::rcp(new Map(invalid, Teuchos::ArrayView<const GO>(gids), 0, comm_));
-  SlabOwner<dim> tie;
+  BoxOwner<dim> tie;
   tie.grid = setup_.grid;
-  tie.axis = slabs_.axis;
-  tie.cuts = &slab_cuts_host_;
+  tie.boxes = &boxes_host_;
   tie.first = global_first_;
   auto one = Tpetra::createOneToOne(Teuchos::RCP<const Map>(overlap0), tie);
   global_nodes_.clear();

@@ -5,15 +5,15 @@
 // fill_system (grid x^n, v^n, mass), the Newton solve, end_step (G2P).
 //
 // MPI (distribute() on more than one rank): each rank holds the particles of
-// its slab (mpm/particle_distribution.hpp) and activates the grid nodes its
+// its box (mpm/particle_distribution.hpp) and activates the grid nodes its
 // particles touch. A grid node touched by several ranks is owned by one of
-// them (Tpetra::createOneToOne; the rank whose slab holds the node's position
+// them (Tpetra::createOneToOne; the rank whose box holds the node's position
 // when it holds the node) and a ghost on the others; the active nodes
 // are numbered owned first, then ghosts (the order DofSpace::set_partition
 // expects), and P2G's partial sums at shared nodes are added at the owner
 // (Export, ADD) and copied back to every holder (Import), so every rank sees
 // the whole mass and momentum of each of its nodes. G2P then needs only local
-// nodes; particles that left the slab migrate at the end of the step.
+// nodes; particles that left the box migrate at the end of the step.
 #include <Kokkos_ScatterView.hpp>
 #include <memory>
 #include <string>
@@ -40,7 +40,7 @@ struct MpmSetup {
   // particle and step; true: the grid grows by whole cells before the step
   // (scene key 'MPM/when particles leave: extend').
   bool extend_domain = false;
-  // MPI: new slab cuts when, after a step's migration, the largest slab holds
+  // MPI: new box cuts when, after a step's migration, the largest box holds
   // more than rebalance_above x the mean particle count (0: never; scene key
   // 'MPM/rebalance above').
   double rebalance_above = 1.2;
@@ -120,7 +120,7 @@ class MpmBodies {
   // This rank's particles (all of them on one rank).
   const Particles<dim>& particles() const { return setup_.particles; }
 
-  // MPI: cut the particles into slabs and keep this rank's (every rank has
+  // MPI: cut the particles into boxes and keep this rank's (every rank has
   // the scene's whole set here); grid nodes get the global system ids
   // global_first + grid index. No-op on one rank.
   void distribute(const Teuchos::RCP<const Teuchos::Comm<int>>& comm, GO global_first);
@@ -131,10 +131,10 @@ class MpmBodies {
   // order (the id at each array position; std::invalid_argument unless it is
   // a permutation of 0..n-1).
   void restore_order(const std::vector<long long>& order);
-  // Particles that left this rank's slab go to their owners (collective; at
-  // the end of a step); then, when the slabs' counts differ more than
-  // rebalance_above allows, new cuts (rebalanced_slabs) and a second exchange.
-  // A rebalance that would not lower the largest slab by 5 % is not made, and
+  // Particles that left this rank's box go to their owners (collective; at
+  // the end of a step); then, when the boxes' counts differ more than
+  // rebalance_above allows, new cuts (rebalanced_boxes) and a second exchange.
+  // A rebalance that would not lower the largest box by 5 % is not made, and
   // not tried again until the imbalance has grown by 5 %. Returns the number
   // moved over all ranks.
   long long migrate();
@@ -159,7 +159,7 @@ class MpmBodies {
   // id of every active node (distributed; empty on one rank).
   LO owned_nodes() const { return distributed_ ? owned_ : active_; }
   const std::vector<GO>& global_nodes() const { return global_nodes_; }
-  const ParticleSlabs<dim>& slabs() const { return slabs_; }
+  const RankBoxes<dim>& boxes() const { return boxes_; }
   const GridSpec<dim>& grid() const { return setup_.grid; }
   TransferScheme scheme() const { return setup_.scheme; }
   LO active_nodes() const { return active_; }
@@ -202,8 +202,8 @@ class MpmBodies {
   Teuchos::RCP<const Teuchos::Comm<int>> comm_;
   bool distributed_ = false;
   GO global_first_ = 0;
-  ParticleSlabs<dim> slabs_;
-  std::vector<double> slab_cuts_host_;  // slabs_.cuts on the host, for the node owners' tie-break
+  RankBoxes<dim> boxes_;
+  RankBoxes<dim, Kokkos::HostSpace> boxes_host_;  // boxes_ on the host, for the node owners' tie-break
   Kokkos::View<long long*, MemSpace> ids_;
   long long n_total_ = 0, migrated_ = 0;
   bool sorted_ = false;  // reordered by cell since construction or replace_particles
@@ -221,7 +221,7 @@ class MpmBodies {
   void resize_stencils();
   void check_inside_grid(long step);
   void number_owned_first(LO first);
-  void set_slabs(const ParticleSlabs<dim>& s);  // slabs_ and its host copy of the cuts
+  void set_boxes(const RankBoxes<dim>& b);  // boxes_ and its host copy
   void sum_shared_nodes();
   double all(double v, Teuchos::EReductionType op) const;  // over the ranks (distributed)
 };

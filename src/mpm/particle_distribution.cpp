@@ -2,8 +2,11 @@
 
 #include <Teuchos_CommHelpers.hpp>
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <limits>
 #include <mpi.h>
+#include <sstream>
 #include <stdexcept>
 
 #include "core/mpi_comm.hpp"
@@ -90,18 +93,20 @@ Kokkos::View<LO*, MemSpace> group_by_dest(Kokkos::View<const int*, MemSpace> des
   return order;
 }
 
-// The same by the slab that holds each particle.
+// The same by the box that holds each particle.
 template <int dim>
-Kokkos::View<LO*, MemSpace> group_by_owner(const Particles<dim>& p, const ParticleSlabs<dim>& s, int first,
+Kokkos::View<LO*, MemSpace> group_by_owner(const Particles<dim>& p, const RankBoxes<dim>& b, int first,
                                            std::vector<long long>& count) {
   const LO np = static_cast<LO>(p.size());
   Kokkos::View<int*, MemSpace> dest("mpm_particle_dest", np);
   const auto px = p.x;
-  const int axis = s.axis;
   Kokkos::parallel_for(
-      "mpm_particle_owner", Kokkos::RangePolicy<ExecSpace>(0, np),
-      KOKKOS_LAMBDA(const LO q) { dest(q) = s.owner(px(q, axis)); });
-  return group_by_dest(dest, s.nranks, first, count);
+      "mpm_particle_owner", Kokkos::RangePolicy<ExecSpace>(0, np), KOKKOS_LAMBDA(const LO q) {
+        Vec<dim> x;
+        for (int c = 0; c < dim; ++c) x(c) = px(q, c);
+        dest(q) = b.owner(x);
+      });
+  return group_by_dest(dest, b.nranks, first, count);
 }
 
 // The same by the id block (id_block_begin) that holds each particle's id.
@@ -194,88 +199,192 @@ std::vector<double> gather_rows(const double* rows, long long n_rows, int width,
 }  // namespace
 
 template <int dim>
-ParticleSlabs<dim> balanced_slabs(const Particles<dim>& all, const GridSpec<dim>& grid, int nranks) {
-  ParticleSlabs<dim> s;
-  s.nranks = nranks;
-  for (int d = 1; d < dim; ++d)
-    if (grid.n_cells[d] > grid.n_cells[s.axis]) s.axis = d;
-  auto x = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), all.x);
-  std::vector<double> c(x.extent(0));
-  for (std::size_t q = 0; q < c.size(); ++q) c[q] = x(q, s.axis);
-  std::sort(c.begin(), c.end());
-  const double o = grid.origin(s.axis), dx = grid.dx;
-  std::vector<double> cuts;
-  for (int r = 1; r < nranks; ++r) {
-    double cut = -std::numeric_limits<double>::infinity();
-    if (!c.empty()) {
-      const std::size_t k = std::min(c.size() - 1, c.size() * r / nranks);
-      cut = o + dx * std::round((c[k] - o) / dx);  // the nearest cell face
-    }
-    if (!cuts.empty()) cut = std::max(cut, cuts.back());
-    cuts.push_back(cut);
+RankBoxes<dim> box_layout(const GridSpec<dim>& grid, int nranks) {
+  if (nranks < 1) throw std::invalid_argument("box_layout: " + std::to_string(nranks) + " ranks, expected >= 1");
+  std::vector<int> primes;
+  for (int n = nranks, f = 2; n > 1;) {
+    if (f * f > n) f = n;
+    while (n % f == 0) primes.push_back(f), n /= f;
+    ++f;
   }
-  s.cuts = Kokkos::View<double*, MemSpace>("mpm_slab_cuts", std::max(nranks - 1, 0));
-  auto h = Kokkos::create_mirror_view(s.cuts);
-  for (int r = 0; r + 1 < nranks; ++r) h(r) = cuts[r];
-  Kokkos::deep_copy(s.cuts, h);
-  return s;
+  std::sort(primes.rbegin(), primes.rend());
+  auto cells = [&](int d) { return static_cast<double>(std::max(grid.n_cells[d], 1)); };
+  std::array<int, 3> parts{1, 1, 1};
+  for (const int f : primes) {
+    int best = 0;
+    for (int d = 1; d < dim; ++d)
+      if (cells(d) / parts[d] > cells(best) / parts[best]) best = d;
+    parts[best] *= f;
+  }
+  std::array<int, dim> order;
+  for (int d = 0; d < dim; ++d) order[d] = d;
+  std::stable_sort(order.begin(), order.end(), [&](int a, int b) {
+    if (parts[a] != parts[b]) return parts[a] > parts[b];
+    return cells(a) > cells(b);
+  });
+  RankBoxes<dim> b;
+  b.nranks = nranks;
+  b.levels = 0;
+  for (int l = 0; l < dim; ++l) {
+    b.axis[l] = order[l];
+    b.parts[l] = parts[order[l]];
+    if (b.parts[l] > 1) b.levels = l + 1;
+  }
+  b.levels = std::max(b.levels, 1);
+  b.cuts = Kokkos::View<double*, MemSpace>("mpm_box_cuts", b.level_offset(b.levels));
+  return b;
 }
 
 template <int dim>
-ParticleSlabs<dim> rebalanced_slabs(const Particles<dim>& p, const ParticleSlabs<dim>& old, const GridSpec<dim>& grid,
-                                    const Teuchos::Comm<int>& comm, long long& largest) {
-  const int axis = old.axis, nranks = comm.getSize();
-  const int layers = std::max(grid.n_cells[axis], 1);
-  const double o = grid.origin(axis), dx = grid.dx;
-  // Bin 0: below the grid; bins 1..layers: the cell layers; bin layers + 1:
-  // above the grid (particles not yet inside an extended grid).
-  Kokkos::View<long long*, MemSpace> hist("mpm_slab_histogram", layers + 2);
-  const auto x = p.x;
-  Kokkos::parallel_for(
-      "mpm_slab_histogram", Kokkos::RangePolicy<ExecSpace>(0, p.size()), KOKKOS_LAMBDA(const LO q) {
-        const double c = std::floor((x(q, axis) - o) / dx);
-        const int k = !(c >= 0.0) ? 0 : c >= layers ? layers + 1 : 1 + static_cast<int>(c);  // NaN: bin 0
-        Kokkos::atomic_add(&hist(k), 1LL);
-      });
-  auto h = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), hist);
-  std::vector<long long> mine(h.data(), h.data() + layers + 2), all(layers + 2, 0);
-  Teuchos::reduceAll(comm, Teuchos::REDUCE_SUM, layers + 2, mine.data(), all.data());
+std::string describe_boxes(const RankBoxes<dim>& b) {
+  const auto h = b.mirror();
+  std::ostringstream s;
+  if (b.levels == 1 || b.parts[1] == 1) {
+    s << "slabs along axis " << b.axis[0] << ", cuts at ";
+    for (std::size_t k = 0; k < h.cuts.extent(0); ++k) s << (k ? ", " : "") << h.cuts(k);
+    s << " m";
+    return s.str();
+  }
+  for (int l = 0; l < b.levels; ++l) s << (l ? " x " : "") << b.parts[l];
+  s << " boxes:";
+  int groups = 1;
+  for (int l = 0; l < b.levels; ++l) {
+    const int n = b.parts[l] - 1, off = b.level_offset(l);
+    s << (l ? ";" : "") << " axis " << b.axis[l] << " cut at ";
+    for (int g = 0; g < groups; ++g) {
+      s << (g ? " | " : "");
+      for (int k = 0; k < n; ++k) s << (k ? ", " : "") << h.cuts(off + g * n + k);
+    }
+    groups *= b.parts[l];
+  }
+  s << " m";
+  return s.str();
+}
+
+namespace {
+
+// Cuts of one group into `parts` along an axis from the group's sorted
+// coordinates: the nearest cell face to each quantile r / parts.
+void quantile_cuts(const std::vector<double>& sorted, int parts, double o, double dx, double* out) {
+  double prev = -std::numeric_limits<double>::infinity();
+  for (int r = 1; r < parts; ++r) {
+    double cut = -std::numeric_limits<double>::infinity();
+    if (!sorted.empty()) {
+      const std::size_t k = std::min(sorted.size() - 1, sorted.size() * r / parts);
+      cut = o + dx * std::round((sorted[k] - o) / dx);  // the nearest cell face
+    }
+    if (r > 1) cut = std::max(cut, prev);
+    out[r - 1] = prev = cut;
+  }
+}
+
+// Cuts of one group into `parts` at the cell faces whose particle count
+// below is nearest r / parts of the group's, from the counts of its bins
+// (bin 0: below the grid; 1..layers: the cell layers; layers + 1: above).
+// Returns the largest part's count.
+long long histogram_cuts(const long long* bins, int layers, int parts, double o, double dx, double* out) {
   // below[f]: particles under face f (coordinate o + f dx), f = 0..layers.
-  std::vector<long long> below(layers + 1, all[0]);
-  for (int k = 0; k < layers; ++k) below[k + 1] = below[k] + all[k + 1];
-  const long long n_all = below[layers] + all[layers + 1];
+  std::vector<long long> below(layers + 1, bins[0]);
+  for (int k = 0; k < layers; ++k) below[k + 1] = below[k] + bins[k + 1];
+  const long long n_all = below[layers] + bins[layers + 1];
   const double total = static_cast<double>(n_all);
-  ParticleSlabs<dim> s;
-  s.axis = axis;
-  s.nranks = nranks;
-  s.cuts = Kokkos::View<double*, MemSpace>("mpm_slab_cuts", std::max(nranks - 1, 0));
-  auto ch = Kokkos::create_mirror_view(s.cuts);
   int face = 0;
-  long long prev = 0;
-  largest = 0;
-  for (int r = 1; r < nranks; ++r) {  // the face whose count below is nearest r / nranks of all
-    const double target = total * r / nranks;
+  long long prev = 0, largest = 0;
+  for (int r = 1; r < parts; ++r) {
+    const double target = total * r / parts;
     while (face < layers && std::abs(static_cast<double>(below[face + 1]) - target) <=
                                 std::abs(static_cast<double>(below[face]) - target))
       ++face;
-    ch(r - 1) = o + dx * face;
+    out[r - 1] = o + dx * face;
     largest = std::max(largest, below[face] - prev);
     prev = below[face];
   }
-  largest = std::max(largest, n_all - prev);
+  return std::max(largest, n_all - prev);
+}
+
+}  // namespace
+
+template <int dim>
+RankBoxes<dim> balanced_boxes(const Particles<dim>& all, const GridSpec<dim>& grid, int nranks) {
+  RankBoxes<dim> b = box_layout(grid, nranks);
+  auto x = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), all.x);
+  auto h = Kokkos::create_mirror_view(b.cuts);
+  std::vector<std::vector<std::size_t>> groups(1);
+  for (std::size_t q = 0; q < x.extent(0); ++q) groups[0].push_back(q);
+  for (int l = 0; l < b.levels; ++l) {
+    const int a = b.axis[l], parts = b.parts[l], n = parts - 1, off = b.level_offset(l);
+    std::vector<std::vector<std::size_t>> next;
+    for (std::size_t g = 0; g < groups.size(); ++g) {
+      std::vector<double> c;
+      c.reserve(groups[g].size());
+      for (const std::size_t q : groups[g]) c.push_back(x(q, a));
+      std::sort(c.begin(), c.end());
+      double* cut = h.data() + off + g * n;
+      quantile_cuts(c, parts, grid.origin(a), grid.dx, cut);
+      std::vector<std::vector<std::size_t>> children(parts);
+      for (const std::size_t q : groups[g]) {
+        int i = 0;
+        while (i < n && x(q, a) >= cut[i]) ++i;
+        children[i].push_back(q);
+      }
+      for (auto& ch : children) next.push_back(std::move(ch));
+    }
+    groups = std::move(next);
+  }
+  Kokkos::deep_copy(b.cuts, h);
+  return b;
+}
+
+template <int dim>
+RankBoxes<dim> rebalanced_boxes(const Particles<dim>& p, const RankBoxes<dim>& old, const GridSpec<dim>& grid,
+                                const Teuchos::Comm<int>& comm, long long& largest) {
+  if (old.nranks != comm.getSize())
+    throw std::logic_error("rebalanced_boxes: a layout for " + std::to_string(old.nranks) + " ranks on " +
+                           std::to_string(comm.getSize()));
+  RankBoxes<dim> s = old;
+  s.cuts = Kokkos::View<double*, MemSpace>("mpm_box_cuts", old.cuts.extent(0));
+  auto ch = Kokkos::create_mirror_view(s.cuts);
+  const auto x = p.x;
+  largest = 0;
+  int groups = 1;
+  for (int l = 0; l < s.levels; ++l) {
+    const int a = s.axis[l], parts = s.parts[l], n = parts - 1, off = s.level_offset(l);
+    const int layers = std::max(grid.n_cells[a], 1), width = layers + 2;
+    const double o = grid.origin(a), dx = grid.dx;
+    Kokkos::deep_copy(s.cuts, ch);  // the levels above are final: they pick each particle's group
+    Kokkos::View<long long*, MemSpace> hist("mpm_box_histogram", static_cast<std::size_t>(groups) * width);
+    const RankBoxes<dim> sd = s;
+    Kokkos::parallel_for(
+        "mpm_box_histogram", Kokkos::RangePolicy<ExecSpace>(0, p.size()), KOKKOS_LAMBDA(const LO q) {
+          Vec<dim> xq;
+          for (int c = 0; c < dim; ++c) xq(c) = x(q, c);
+          const double c = std::floor((xq(a) - o) / dx);
+          const int k = !(c >= 0.0) ? 0 : c >= layers ? layers + 1 : 1 + static_cast<int>(c);  // NaN: bin 0
+          Kokkos::atomic_add(&hist(sd.group(xq, l) * width + k), 1LL);
+        });
+    auto h = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), hist);
+    std::vector<long long> all(h.extent(0), 0);
+    Teuchos::reduceAll(comm, Teuchos::REDUCE_SUM, static_cast<int>(all.size()), h.data(), all.data());
+    for (int g = 0; g < groups; ++g) {
+      const long long most = histogram_cuts(all.data() + static_cast<std::size_t>(g) * width, layers, parts, o, dx,
+                                            ch.data() + off + g * n);
+      if (l == s.levels - 1) largest = std::max(largest, most);
+    }
+    groups *= parts;
+  }
   Kokkos::deep_copy(s.cuts, ch);
   return s;
 }
 
 template <int dim>
-Particles<dim> select_slab(const Particles<dim>& all, const ParticleSlabs<dim>& slabs, int rank,
-                           Kokkos::View<long long*, MemSpace>& ids) {
+Particles<dim> select_box(const Particles<dim>& all, const RankBoxes<dim>& boxes, int rank,
+                          Kokkos::View<long long*, MemSpace>& ids) {
   const LO np = static_cast<LO>(all.size());
   Kokkos::View<long long*, MemSpace> all_ids("mpm_particle_ids_all", np);
   Kokkos::parallel_for(
       "mpm_ids_identity", Kokkos::RangePolicy<ExecSpace>(0, np), KOKKOS_LAMBDA(const LO q) { all_ids(q) = q; });
   std::vector<long long> count;
-  auto order = group_by_owner(all, slabs, rank, count);
+  auto order = group_by_owner(all, boxes, rank, count);
   const LO mine = static_cast<LO>(count[rank]);
   Buffer buf("mpm_select_buffer", mine, kFields<dim>);
   pack<dim>(all, all_ids, Kokkos::subview(order, std::make_pair(LO(0), mine)), buf);
@@ -287,13 +396,13 @@ Particles<dim> select_slab(const Particles<dim>& all, const ParticleSlabs<dim>& 
 }
 
 template <int dim>
-long long migrate_particles(Particles<dim>& p, Kokkos::View<long long*, MemSpace>& ids, const ParticleSlabs<dim>& slabs,
+long long migrate_particles(Particles<dim>& p, Kokkos::View<long long*, MemSpace>& ids, const RankBoxes<dim>& boxes,
                             const Teuchos::Comm<int>& comm, long long& largest) {
   const int me = comm.getRank(), n = comm.getSize();
   largest = static_cast<long long>(p.size());
   if (n == 1) return 0;
   std::vector<long long> count;
-  auto order = group_by_owner(p, slabs, me, count);
+  auto order = group_by_owner(p, boxes, me, count);
   const long long np = static_cast<long long>(p.size());
   // One allreduce: summed over the senders, count[r] is rank r's particle
   // count after the exchange, and the appended entry (this rank's leavers)
@@ -433,13 +542,15 @@ Kokkos::View<double*, MemSpace> particle_values_in_id_block(Kokkos::View<const d
 }
 
 #define BFEMP_INSTANTIATE(D)                                                                                        \
-  template ParticleSlabs<D> balanced_slabs<D>(const Particles<D>&, const GridSpec<D>&, int);                        \
-  template ParticleSlabs<D> rebalanced_slabs<D>(const Particles<D>&, const ParticleSlabs<D>&, const GridSpec<D>&,    \
-                                                const Teuchos::Comm<int>&, long long&);                             \
-  template Particles<D> select_slab<D>(const Particles<D>&, const ParticleSlabs<D>&, int,                          \
-                                       Kokkos::View<long long*, MemSpace>&);                                        \
+  template RankBoxes<D> box_layout<D>(const GridSpec<D>&, int);                                                    \
+  template std::string describe_boxes<D>(const RankBoxes<D>&);                                                     \
+  template RankBoxes<D> balanced_boxes<D>(const Particles<D>&, const GridSpec<D>&, int);                           \
+  template RankBoxes<D> rebalanced_boxes<D>(const Particles<D>&, const RankBoxes<D>&, const GridSpec<D>&,          \
+                                            const Teuchos::Comm<int>&, long long&);                                 \
+  template Particles<D> select_box<D>(const Particles<D>&, const RankBoxes<D>&, int,                               \
+                                      Kokkos::View<long long*, MemSpace>&);                                         \
   template long long migrate_particles<D>(Particles<D>&, Kokkos::View<long long*, MemSpace>&,                      \
-                                          const ParticleSlabs<D>&, const Teuchos::Comm<int>&, long long&);          \
+                                          const RankBoxes<D>&, const Teuchos::Comm<int>&, long long&);              \
   template Particles<D> gather_particles<D>(const Particles<D>&, Kokkos::View<const long long*, MemSpace>, long long, \
                                             const Teuchos::Comm<int>&, int);                                        \
   template Particles<D> particles_in_id_block<D>(const Particles<D>&, Kokkos::View<const long long*, MemSpace>,     \

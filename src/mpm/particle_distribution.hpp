@@ -1,17 +1,31 @@
 #pragma once
-// The MPM particles cut into the ranks of a communicator: slabs along one
-// axis of the grid (the one with the most cells), each rank owning the
-// particles whose coordinate on that axis lies in its slab,
-//   rank r owns x_axis in [cut_{r-1}, cut_r)   (cut_{-1} = -inf, cut_{R-1} = +inf),
-// with the cuts at cell faces (origin + dx k) chosen so that every slab holds
-// about the same number of particles when the cuts are made. A slab keeps its
-// cuts (fixed in space, not in grid index: they survive grid extensions); a
-// particle that leaves its slab migrates to the owning rank at the end of the
-// step (migrate_particles: one all-to-all exchange, fields packed on device).
-// Why slabs and not Zoltan2 boxes: one cut coordinate per rank pair makes the
-// owner of a position a kernel-side comparison, and for the 2-64 ranks of the
-// scenes in view a slab's halo (one node layer each side) stays small; the
-// cost is a halo that grows with the cross-section instead of the surface.
+// The MPM particles cut into the ranks of a communicator: boxes of a jagged
+// Cartesian decomposition (Zoltan2's "multi-jagged" layout), each rank owning
+// the particles whose position lies in its box. The R ranks are
+// parts[0] x parts[1] (x parts[2]) boxes, cut level by level:
+//   level 0: parts[0] - 1 cuts along axis[0] split the particles into slabs;
+//   level 1: each slab i gets its own parts[1] - 1 cuts along axis[1];
+//   level 2: each column (i, j) its own parts[2] - 1 cuts along axis[2];
+// and the box (i, j, k) is rank (i parts[1] + j) parts[2] + k. A level of
+// parts 1 has no cuts. Within a group a part holds
+//   x_axis in [cut_{k-1}, cut_k)   (cut_{-1} = -inf, cut_{last} = +inf),
+// with the cuts at cell faces (origin + dx k) chosen so that every part of a
+// group holds about the same number of particles when the cuts are made. The
+// cuts are fixed in space, not in grid index (they survive grid extensions);
+// a particle that leaves its box migrates to the owning rank at the end of
+// the step (migrate_particles: one all-to-all exchange, fields packed on
+// device).
+// parts: R's prime factors, largest first, each given to the axis with the
+// most grid cells per part so far (the first such axis), so the boxes come
+// out about cubic in cells; the levels go in decreasing parts (ties: the axis
+// with more cells, then the lower axis). R prime (2, 3, 5, ...): one level of
+// slabs along the axis with the most cells. Why not Zoltan2's RCB on the
+// particles: the owner of a position is then a kernel-side lookup of at most
+// three short cut lists, and the boxes' faces are cell faces. Why boxes and
+// not slabs only: a slab's halo is the body's whole cross-section, and a body
+// of n cells per edge has at most n / 2 slabs of two cells (the B-spline
+// halo); boxes keep the halo to a box's surface (perf/README, the projection
+// to 64 ranks).
 //
 // Every particle has a global id (its index in the scene's particle list),
 // carried through every migration. Output frames redistribute the particles
@@ -21,6 +35,7 @@
 // one on 1 rank. One rank: nothing moves, ids are 0..n-1.
 #include <Kokkos_Core.hpp>
 #include <Teuchos_Comm.hpp>
+#include <string>
 #include <vector>
 
 #include "kernels/mpm/grid.hpp"
@@ -28,47 +43,106 @@
 
 namespace bfemp {
 
-template <int dim>
-struct ParticleSlabs {
-  int axis = 0;
+// The layout and cuts of the boxes. Space: where `cuts` lives (a host copy
+// for host-side lookups: mirror()).
+template <int dim, class Space = MemSpace>
+struct RankBoxes {
   int nranks = 1;
-  Kokkos::View<double*, MemSpace> cuts;  // nranks - 1 ascending cut coordinates
+  int levels = 1;                     // cut levels (1: slabs)
+  Kokkos::Array<int, 3> axis{{0, 1, 2}};   // axis of level l
+  Kokkos::Array<int, 3> parts{{1, 1, 1}};  // parts of level l (their product: nranks)
+  // Level 0's parts[0] - 1 cuts, then level 1's parts[1] - 1 cuts of each of
+  // the parts[0] slabs, then level 2's parts[2] - 1 of each of the
+  // parts[0] parts[1] columns; ascending within a group.
+  Kokkos::View<double*, Space> cuts;
 
-  KOKKOS_INLINE_FUNCTION int owner(double coordinate) const {
-    int r = 0;
-    while (r < nranks - 1 && coordinate >= cuts(r)) ++r;
-    return r;
+  // The group (rank, at l = levels) that holds x after the first l levels.
+  template <class X>
+  KOKKOS_INLINE_FUNCTION int group(const X& x, int l) const {
+    int g = 0, offset = 0, groups = 1;
+    for (int k = 0; k < l; ++k) {
+      const int n = parts[k] - 1, start = offset + g * n;
+      const double c = x[axis[k]];
+      int i = 0;
+      while (i < n && c >= cuts(start + i)) ++i;
+      offset += groups * n;
+      groups *= parts[k];
+      g = g * parts[k] + i;
+    }
+    return g;
+  }
+  // The rank whose box holds position x (x[a]: coordinate a).
+  template <class X>
+  KOKKOS_INLINE_FUNCTION int owner(const X& x) const { return group(x, levels); }
+  // Index of the first cut of level l (the cuts of its group g follow at g (parts[l] - 1)).
+  KOKKOS_INLINE_FUNCTION int level_offset(int l) const {
+    int offset = 0, groups = 1;
+    for (int k = 0; k < l; ++k) offset += groups * (parts[k] - 1), groups *= parts[k];
+    return offset;
+  }
+  // Sum over the levels of |index of a's part - index of b's part| (rank
+  // digits in the mixed radix of parts): how far apart two ranks' boxes lie
+  // in the layout (for slabs, |a - b|).
+  KOKKOS_INLINE_FUNCTION int distance(int a, int b) const {
+    int d = 0;
+    for (int l = levels - 1; l >= 0; --l) {
+      const int ia = a % parts[l], ib = b % parts[l];
+      d += ia > ib ? ia - ib : ib - ia;
+      a /= parts[l];
+      b /= parts[l];
+    }
+    return d;
+  }
+  RankBoxes<dim, Kokkos::HostSpace> mirror() const {
+    RankBoxes<dim, Kokkos::HostSpace> h;
+    h.nranks = nranks;
+    h.levels = levels;
+    h.axis = axis;
+    h.parts = parts;
+    h.cuts = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), cuts);
+    return h;
   }
 };
 
-// Cuts for `nranks` slabs of about equal particle counts (every rank passes
-// the same `all`; no communication). One-off host work (setup, restart).
+// The layout for nranks boxes over `grid` (see the file's comment).
 template <int dim>
-ParticleSlabs<dim> balanced_slabs(const Particles<dim>& all, const GridSpec<dim>& grid, int nranks);
+RankBoxes<dim> box_layout(const GridSpec<dim>& grid, int nranks);
 
-// Cuts along old.axis at cell faces that split the particles of all ranks
-// (p: this rank's) into slabs of about equal counts, from the particle count
-// of every cell layer summed over the ranks (collective: one sum of
-// grid.n_cells[axis] + 2 counts; particles below or above the grid, not yet
-// in an extended grid, have a bin each: they stay on the first or last slab).
-// largest: the most particles a new slab holds. Work O(particles / ranks +
-// layers); for a rebalance, not for every step.
+// "slabs along axis 0, cuts at 0.5, 1 m" or "2 x 2 boxes: axis 0 cut at 0.5;
+// axis 1 cut at 0.3 | 0.4 m" (the banner of a run).
 template <int dim>
-ParticleSlabs<dim> rebalanced_slabs(const Particles<dim>& p, const ParticleSlabs<dim>& old, const GridSpec<dim>& grid,
-                                    const Teuchos::Comm<int>& comm, long long& largest);
+std::string describe_boxes(const RankBoxes<dim>& b);
 
-// The particles of `all` in slab `rank`, and their indices in `all` (ids).
+// Cuts for box_layout(grid, nranks) with about equal particle counts per
+// part at every level (every rank passes the same `all`; no communication).
+// One-off host work (setup, restart).
 template <int dim>
-Particles<dim> select_slab(const Particles<dim>& all, const ParticleSlabs<dim>& slabs, int rank,
-                           Kokkos::View<long long*, MemSpace>& ids);
+RankBoxes<dim> balanced_boxes(const Particles<dim>& all, const GridSpec<dim>& grid, int nranks);
 
-// Sends every particle outside this rank's slab to its owner and receives
+// New cuts in old's layout at cell faces that split the particles of all
+// ranks (p: this rank's) into parts of about equal counts, level by level,
+// from the particle count of every cell layer of every group summed over the
+// ranks (collective: per level one sum of groups x (grid.n_cells[axis] + 2)
+// counts; particles below or above the grid, not yet in an extended grid,
+// have a bin each: they stay in the first or last part). largest: the most
+// particles a new box holds. Work O(particles / ranks + groups x layers);
+// for a rebalance, not for every step.
+template <int dim>
+RankBoxes<dim> rebalanced_boxes(const Particles<dim>& p, const RankBoxes<dim>& old, const GridSpec<dim>& grid,
+                                const Teuchos::Comm<int>& comm, long long& largest);
+
+// The particles of `all` in box `rank`, and their indices in `all` (ids).
+template <int dim>
+Particles<dim> select_box(const Particles<dim>& all, const RankBoxes<dim>& boxes, int rank,
+                          Kokkos::View<long long*, MemSpace>& ids);
+
+// Sends every particle outside this rank's box to its owner and receives
 // those entering (collective). p and ids are replaced when anything moved
 // anywhere. Returns the number of particles that moved, summed over ranks,
 // and sets `largest` to the largest rank's particle count after the exchange:
 // both come from one allreduce of the per-destination counts.
 template <int dim>
-long long migrate_particles(Particles<dim>& p, Kokkos::View<long long*, MemSpace>& ids, const ParticleSlabs<dim>& slabs,
+long long migrate_particles(Particles<dim>& p, Kokkos::View<long long*, MemSpace>& ids, const RankBoxes<dim>& boxes,
                             const Teuchos::Comm<int>& comm, long long& largest);
 
 // All ranks' particles on rank `root`, placed by id (0..n_total-1); other

@@ -24,66 +24,19 @@
 #include <cmath>
 #include <mpi.h>
 
-#include "common/mpi_checks.hpp"
-#include "common/mpm_fixtures.hpp"
+#include "common/mpm_mpi_checks.hpp"
 #include "io/scene.hpp"
 
 using namespace bfemp;
 
 namespace {
 
-struct Result {
-  std::vector<double> x, v;  // gathered particles (rank 0), id order
-  std::vector<int> iterations;
-  double kinetic = 0, elastic = 0;
-  std::array<double, 3> momentum{0, 0, 0}, momentum0{0, 0, 0};
-  long long migrated = 0;
-  std::size_t local_particles = 0;
-  double worst_imbalance = 1.0;  // largest / mean particles per rank, the worst step end
-};
-
+using fixtures::compare;
 using fixtures::expect_same_on_every_rank;
-
-template <int dim>
-Result run_steps(Simulation<dim>& sim, int steps) {
-  Result r;
-  r.momentum0 = sim.diagnostics().momentum;
-  for (int s = 0; s < steps; ++s) {
-    const StepReport rep = sim.step();
-    r.iterations.push_back(rep.newton.iterations);
-    r.kinetic = rep.kinetic;
-    r.elastic = rep.elastic;
-    r.momentum = rep.momentum;
-    r.worst_imbalance = std::max(r.worst_imbalance, sim.mpm()->imbalance());
-  }
-  const Particles<dim> p = sim.mpm()->gathered_particles();
-  auto x = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), p.x);
-  auto v = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), p.v);
-  r.x.assign(x.data(), x.data() + x.size());
-  r.v.assign(v.data(), v.data() + v.size());
-  r.migrated = sim.mpm()->migrated_particles();
-  r.local_particles = sim.mpm()->particles().size();
-  return r;
-}
-
-template <int dim>
-void set_velocity(Particles<dim>& p, std::size_t first, std::size_t last, const Vec<dim>& vel) {
-  auto v = p.v;
-  Kokkos::parallel_for(
-      "test_velocity", Kokkos::RangePolicy<ExecSpace>(first, last), KOKKOS_LAMBDA(const std::size_t q) {
-        for (int c = 0; c < dim; ++c) v(q, c) = vel(c);
-      });
-  Kokkos::fence();
-}
-
-// CG (any rank count) to 1e-13, Newton to |p|_inf / dt < 1e-9 m/s: the runs
-// on several ranks and on one then agree to about 1e-12 m.
-template <int dim>
-void tight_cg(SimulationSetup<dim>& s) {
-  s.linear_solver.set("type", std::string("CG"));
-  s.linear_solver.sublist("CG").set("tolerance", 1e-13);
-  s.newton.eps_d = 1e-9;
-}
+using fixtures::run_steps;
+using fixtures::set_velocity;
+using fixtures::tight_cg;
+using fixtures::Result;
 
 SimulationSetup<2> two_blocks() {
   auto s = fixtures::mpm_rect_setup(0.3, 0.3, Vec<2>(0.5, 0.4), 0.05, 4, Vec<2>(0.0, 0.0), Vec<2>(2.4, 0.8),
@@ -102,26 +55,6 @@ SimulationSetup<2> two_blocks() {
   s.integrator = TimeIntegrator::backward_euler();
   tight_cg(s);
   return s;
-}
-
-template <int dim>
-void compare(const Comm& world, const Result& d, const Result& s, double x_tol, const std::string& what) {
-  expect_same_on_every_rank(world, d.iterations);
-  if (world.getRank() != 0) return;
-  ASSERT_EQ(d.x.size(), s.x.size()) << what;
-  ASSERT_FALSE(d.x.empty()) << what;
-  double ex = 0, ev = 0, vs = 0;
-  for (std::size_t i = 0; i < d.x.size(); ++i) {
-    ex = std::max(ex, std::abs(d.x[i] - s.x[i]));
-    ev = std::max(ev, std::abs(d.v[i] - s.v[i]));
-    vs = std::max(vs, std::abs(s.v[i]));
-  }
-  EXPECT_LT(ex, x_tol) << what;
-  EXPECT_LT(ev, 1e-6 * vs) << what;
-  EXPECT_NEAR(d.kinetic, s.kinetic, 1e-7 * s.kinetic) << what;
-  EXPECT_NEAR(d.elastic, s.elastic, 1e-6 * std::max(s.elastic, 1e-12)) << what;
-  std::cout << what << ", " << world.getSize() << " rank(s): |x - x_alone| = " << ex << " m, |v - v_alone| = " << ev
-            << " m/s, " << d.migrated << " particle migrations\n";
 }
 
 }  // namespace
@@ -175,8 +108,8 @@ TEST(MpmMpi, SharedGridNodesAreOwnedOnTheirSideOfTheCut) {
   const Result d = run_steps(dist, 3);
   const auto& mpm = *dist.mpm();
   const auto& grid = mpm.grid();
-  auto cuts = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), mpm.slabs().cuts);
-  const int axis = mpm.slabs().axis, rank = world->getRank();
+  const auto boxes = mpm.boxes().mirror();
+  const int axis = boxes.axis[0], rank = world->getRank();
   long wrong = 0, shared_owned = 0;
   const auto& g = mpm.global_nodes();  // owned first, then ghosts; no FEM nodes before them (empty on 1 rank)
   // (EXPECT, not ASSERT: every rank must reach compare()'s collective checks)
@@ -184,12 +117,12 @@ TEST(MpmMpi, SharedGridNodesAreOwnedOnTheirSideOfTheCut) {
   EXPECT_TRUE(numbered) << "rank " << rank << ": " << g.size() << " global node ids for " << mpm.active_nodes()
                         << " active nodes";
   for (std::size_t k = 0; numbered && k < g.size(); ++k) {
-    const double c = grid.node_position(static_cast<LO>(g[k]))(axis);
-    int side = 0;
-    while (side < static_cast<int>(cuts.extent(0)) && c >= cuts(side)) ++side;
+    Vec<2> c = grid.node_position(static_cast<LO>(g[k]));
+    const int side = boxes.owner(c);
     const bool owned = static_cast<LO>(k) < mpm.owned_nodes();
     if (owned != (side == rank)) ++wrong;
-    if (owned && std::abs(c - (side > 0 ? cuts(side - 1) : -1e9)) < 2 * grid.dx) ++shared_owned;
+    c(axis) -= 2 * grid.dx;  // within two cells of its lower cut
+    if (owned && boxes.owner(c) != rank) ++shared_owned;
   }
   EXPECT_EQ(wrong, 0) << "rank " << rank << ": active nodes owned against their side of the cut";
   if (world->getSize() > 1 && rank > 0)
@@ -399,7 +332,7 @@ TEST(MpmMpi, SlabsRebalanceWhenParticlesCrowdOneRank) {
   }
 }
 
-// rebalanced_slabs on a known histogram: grid covering [0, 1]^2, dx 0.1
+// rebalanced_boxes (slabs) on a known histogram: grid covering [0, 1]^2, dx 0.1
 // (faces -0.1 .. 1.1 along x); of 20 particles, 6 lie below the grid
 // (x = -0.5), 4 inside (x = 0.25) and 10 above it (x = 1.5), spread over the
 // ranks by index. On 2 ranks the cut that
@@ -420,11 +353,11 @@ TEST(MpmMpi, RebalancedCutsCountParticlesOutsideTheGridOnTheirSide) {
     xh(q, 1) = 0.5;
   }
   Kokkos::deep_copy(p.x, xh);
-  ParticleSlabs<2> old;
-  old.axis = 0;
-  old.nranks = n;
+  const RankBoxes<2> old = box_layout<2>(grid, n);
+  ASSERT_EQ(old.axis[0], 0);
+  ASSERT_EQ(old.levels, 1);  // slabs on 1-3 ranks
   long long largest = 0;
-  const ParticleSlabs<2> s = rebalanced_slabs<2>(p, old, grid, *world, largest);
+  const RankBoxes<2> s = rebalanced_boxes<2>(p, old, grid, *world, largest);
   auto cuts = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), s.cuts);
   ASSERT_EQ(static_cast<int>(cuts.extent(0)), n - 1);
   if (n == 1) {
@@ -462,8 +395,9 @@ TEST(MpmMpi, MigrationReportsMovedAndLargestFromOneReduction) {
   }
   Kokkos::deep_copy(p.x, xh);
   Kokkos::deep_copy(ids, ih);
-  ParticleSlabs<2> slabs;
-  slabs.axis = 0;
+  RankBoxes<2> slabs;
+  slabs.axis[0] = 0;
+  slabs.parts[0] = n;
   slabs.nranks = n;
   slabs.cuts = decltype(slabs.cuts)("cuts", n - 1);
   auto ch = Kokkos::create_mirror_view(slabs.cuts);

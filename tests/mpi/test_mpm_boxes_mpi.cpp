@@ -1,0 +1,302 @@
+// MPM particles in boxes (mpm/particle_distribution.hpp: a jagged Cartesian
+// decomposition, parts[0] x parts[1] (x parts[2]) ranks), run on 1 and 4
+// ranks:
+//   - the layout (host, any rank count): R's prime factors given to the axes
+//     with the most cells per part; 2 and 3 ranks stay slabs along the axis
+//     with the most cells (the layout before boxes);
+//   - balanced_boxes on known particle sets: equal counts in every box, each
+//     slab with its own cuts, owner() the box the cuts give;
+//   - on 4 ranks (2 x 2 boxes): a 2D block thrown diagonally across both
+//     cuts into a resting block, through contact on the grid, equals the same
+//     scene on one rank alone; particles migrated, every particle ends in its
+//     rank's box, and a grid node is owned by the rank whose box holds it;
+//     the same with the boxes rebalanced as the particles crowd (every rank
+//     recomputes the jagged cuts from the summed histograms), and a 3D cube
+//     thrown across the cuts of 2 x 2 x 1 boxes.
+#include <gtest/gtest.h>
+
+#include <Teuchos_CommHelpers.hpp>
+#include <Teuchos_DefaultMpiComm.hpp>
+#include <Tpetra_Core.hpp>
+#include <algorithm>
+#include <cmath>
+#include <mpi.h>
+
+#include "common/mpm_mpi_checks.hpp"
+#include "mpm/particle_distribution.hpp"
+
+using namespace bfemp;
+
+namespace {
+
+using fixtures::compare;
+using fixtures::Result;
+using fixtures::run_steps;
+using fixtures::set_velocity;
+using fixtures::tight_cg;
+
+template <int dim>
+GridSpec<dim> grid_of(const std::array<int, 3>& cells) {
+  GridSpec<dim> g;
+  g.dx = 0.1;
+  for (int d = 0; d < dim; ++d) {
+    g.origin(d) = 0.0;
+    g.n_cells[d] = cells[d];
+  }
+  return g;
+}
+
+// n^dim particles on a regular lattice in [0, 1]^dim (spacing 1 / n, offset
+// half a spacing), x fastest.
+template <int dim>
+Particles<dim> lattice(int n) {
+  const std::size_t total = dim == 2 ? n * n : n * n * n;
+  Particles<dim> p = allocate_particles<dim>(total);
+  auto x = Kokkos::create_mirror_view(p.x);
+  for (std::size_t q = 0; q < total; ++q) {
+    std::size_t r = q;
+    for (int d = 0; d < dim; ++d) {
+      x(q, d) = (static_cast<double>(r % n) + 0.5) / n;
+      r /= n;
+    }
+  }
+  Kokkos::deep_copy(p.x, x);
+  return p;
+}
+
+// Particles per rank of `b` (host).
+template <int dim>
+std::vector<int> counts(const Particles<dim>& p, const RankBoxes<dim>& b) {
+  const auto h = b.mirror();
+  auto x = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), p.x);
+  std::vector<int> c(b.nranks, 0);
+  for (std::size_t q = 0; q < x.extent(0); ++q) {
+    Vec<dim> xq;
+    for (int d = 0; d < dim; ++d) xq(d) = x(q, d);
+    ++c[h.owner(xq)];
+  }
+  return c;
+}
+
+}  // namespace
+
+TEST(RankBoxes, LayoutGivesTheRanksToTheAxesWithTheMostCellsPerPart) {
+  auto parts_of = [](const RankBoxes<3>& b) {
+    std::array<int, 3> p{1, 1, 1};
+    for (int l = 0; l < b.levels; ++l) p[b.axis[l]] = b.parts[l];
+    return p;
+  };
+  const auto twist = grid_of<3>({32, 32, 28});  // the A7 twist's grid
+  for (int r : {1, 2, 3}) {  // slabs along the first axis with the most cells, as before boxes
+    const auto b = box_layout<3>(twist, r);
+    EXPECT_EQ(b.levels, 1) << r;
+    EXPECT_EQ(b.axis[0], 0) << r;
+    EXPECT_EQ(b.parts[0], r) << r;
+    EXPECT_EQ(static_cast<int>(b.cuts.extent(0)), r - 1) << r;
+  }
+  EXPECT_EQ(box_layout<3>(grid_of<3>({10, 30, 20}), 2).axis[0], 1);
+  EXPECT_EQ(parts_of(box_layout<3>(twist, 4)), (std::array<int, 3>{2, 2, 1}));
+  EXPECT_EQ(parts_of(box_layout<3>(twist, 8)), (std::array<int, 3>{2, 2, 2}));
+  EXPECT_EQ(parts_of(box_layout<3>(twist, 6)), (std::array<int, 3>{3, 2, 1}));
+  EXPECT_EQ(parts_of(box_layout<3>(twist, 64)), (std::array<int, 3>{4, 4, 4}));
+  const auto b12 = box_layout<2>(grid_of<2>({48, 16, 1}), 12);  // 3 to x, 2 to x (16 = 16), 2 to y
+  EXPECT_EQ(b12.levels, 2);
+  EXPECT_EQ(b12.axis[0], 0);
+  EXPECT_EQ(b12.parts[0], 6);
+  EXPECT_EQ(b12.parts[1], 2);
+  EXPECT_EQ(static_cast<int>(b12.cuts.extent(0)), 5 + 6 * 1);
+  // distance: rank digits (i, j) of 2 x 2 boxes
+  const auto b4 = box_layout<2>(grid_of<2>({20, 20, 1}), 4);
+  EXPECT_EQ(b4.distance(0, 3), 2);
+  EXPECT_EQ(b4.distance(1, 2), 2);
+  EXPECT_EQ(b4.distance(0, 1), 1);
+  EXPECT_EQ(b4.distance(2, 0), 1);
+  EXPECT_EQ(b4.distance(3, 3), 0);
+  EXPECT_THROW(box_layout<2>(grid_of<2>({20, 20, 1}), 0), std::invalid_argument);
+}
+
+// 2D: 40 x 40 particles in [0, 1]^2 on a 10 x 10 grid, 4 ranks: 2 x 2 boxes
+// of 400 each, cuts at 0.5; 3D: 20^3 in 8 boxes of 1000. A lattice that is
+// denser in the left half (x < 0.5: its points doubled) gets a slab cut that
+// halves the count, then each slab its own y cut.
+TEST(RankBoxes, BalancedBoxesHoldEqualCountsAndEachSlabHasItsOwnCuts) {
+  const auto g2 = grid_of<2>({10, 10, 1});
+  const auto p2 = lattice<2>(40);
+  const auto b = balanced_boxes<2>(p2, g2, 4);
+  ASSERT_EQ(b.levels, 2);
+  EXPECT_EQ(counts<2>(p2, b), (std::vector<int>{400, 400, 400, 400}));
+  const auto h = b.mirror();
+  ASSERT_EQ(h.cuts.extent(0), 3u);
+  for (int k = 0; k < 3; ++k) EXPECT_NEAR(h.cuts(k), 0.5, 1e-12) << k;
+  EXPECT_EQ(h.owner(Vec<2>(0.2, 0.7)), 1);  // (i, j) = (0, 1)
+  EXPECT_EQ(h.owner(Vec<2>(0.7, 0.2)), 2);
+  EXPECT_EQ(h.owner(Vec<2>(0.5, 0.5)), 3);  // on the cuts: the upper part
+  EXPECT_EQ(h.owner(Vec<2>(-5.0, 9.0)), 1);  // outside the grid: the nearest part
+
+  const auto p3 = lattice<3>(20);
+  const auto b3 = balanced_boxes<3>(p3, grid_of<3>({10, 10, 10}), 8);
+  EXPECT_EQ(counts<3>(p3, b3), std::vector<int>(8, 1000));
+
+  // Uneven: the left slab (x < 0.5) has its particles in y < 0.3 only.
+  Particles<2> q = allocate_particles<2>(800);
+  auto x = Kokkos::create_mirror_view(q.x);
+  for (int k = 0; k < 400; ++k) {
+    x(k, 0) = 0.025 + 0.05 * (k % 10);  // x in (0, 0.5)
+    x(k, 1) = 0.0075 * (k / 10) + 0.001;  // y in (0, 0.3)
+    x(400 + k, 0) = 0.525 + 0.05 * (k % 10);  // x in (0.5, 1)
+    x(400 + k, 1) = 0.025 * (k / 10) + 0.001;  // y in (0, 1)
+  }
+  Kokkos::deep_copy(q.x, x);
+  const auto bu = balanced_boxes<2>(q, g2, 4);
+  const auto hu = bu.mirror();
+  EXPECT_NEAR(hu.cuts(0), 0.5, 1e-12);
+  EXPECT_NEAR(hu.cuts(1), 0.2, 1e-12);  // the left slab's median y (0.15), at the nearest face
+  EXPECT_NEAR(hu.cuts(2), 0.5, 1e-12);  // the right slab's
+  const auto cu = counts<2>(q, bu);
+  EXPECT_EQ(cu[2], 400 / 2);
+  EXPECT_EQ(cu[3], 400 / 2);
+  EXPECT_EQ(cu[0] + cu[1], 400);
+}
+
+namespace {
+
+// Two 0.3 x 0.3 blocks on a square grid [0, 1.6]^2 (32 x 32 cells: 2 x 2
+// boxes on 4 ranks): one at (0.45, 0.45) thrown at (2.5, 2.5) m/s into one at
+// rest at (1.1, 1.1). The x cut falls between the blocks, each slab's y cut
+// through its block's middle: the thrown block starts on ranks 0 and 1 and
+// crosses into 2 and 3.
+SimulationSetup<2> diagonal_blocks(double rebalance_above) {
+  auto s = fixtures::mpm_rect_setup(0.3, 0.3, Vec<2>(0.45, 0.45), 0.05, 4, Vec<2>(0.0, 0.0), Vec<2>(1.6, 1.6),
+                                    TransferScheme::APIC);
+  auto other = fixtures::mpm_rect_setup(0.3, 0.3, Vec<2>(1.1, 1.1), 0.05, 4, Vec<2>(0.0, 0.0), Vec<2>(1.6, 1.6),
+                                        TransferScheme::APIC);
+  const std::size_t nl = s.mpm->particles.size();
+  s.mpm->particles = concatenate<2>({s.mpm->particles, other.mpm->particles});
+  auto body = s.mpm->particles.body;
+  Kokkos::parallel_for(
+      "test_body", Kokkos::RangePolicy<ExecSpace>(nl, s.mpm->particles.size()),
+      KOKKOS_LAMBDA(const std::size_t q) { body(q) = 1; });
+  s.mpm->body_names = {"thrown", "resting"};
+  s.mpm->rebalance_above = rebalance_above;
+  set_velocity<2>(s.mpm->particles, 0, nl, Vec<2>(2.5, 2.5));
+  s.dt = 5e-3;
+  s.integrator = TimeIntegrator::backward_euler();
+  tight_cg(s);
+  return s;
+}
+
+// Every local particle in this rank's box (bad[0] counts the others), and
+// the owners of the last step's active nodes (bad[1] counts the violations):
+// a node held by the rank whose box of that step holds its position
+// (`step_boxes`: the boxes before the step's migration, which may rebalance
+// them) is owned by that rank; a node that rank does not hold is owned by
+// one of its holders. Collective: every rank's active node ids to every rank.
+template <int dim>
+std::array<long, 2> outside_own_box(const MpmBodies<dim>& mpm, const Comm& world,
+                                    const RankBoxes<dim, Kokkos::HostSpace>& step_boxes) {
+  const int rank = world.getRank(), n = world.getSize();
+  const auto b = mpm.boxes().mirror();
+  auto x = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), mpm.particles().x);
+  std::array<long, 2> bad{0, 0};
+  for (std::size_t q = 0; q < x.extent(0); ++q) {
+    Vec<dim> xq;
+    for (int d = 0; d < dim; ++d) xq(d) = x(q, d);
+    if (b.owner(xq) != rank) ++bad[0];
+  }
+  // held[r]: rank r's active node ids (sorted)
+  const std::vector<GO>& g = mpm.global_nodes();
+  std::vector<long long> mine(g.begin(), g.end());
+  int count = static_cast<int>(mine.size());
+  std::vector<int> counts(n), disp(n, 0);
+  MPI_Allgather(&count, 1, MPI_INT, counts.data(), 1, MPI_INT, MPI_COMM_WORLD);
+  for (int r = 1; r < n; ++r) disp[r] = disp[r - 1] + counts[r - 1];
+  std::vector<long long> all(disp[n - 1] + counts[n - 1]);
+  MPI_Allgatherv(mine.data(), count, MPI_LONG_LONG, all.data(), counts.data(), disp.data(), MPI_LONG_LONG,
+                 MPI_COMM_WORLD);
+  std::vector<std::vector<long long>> held(n);
+  for (int r = 0; r < n; ++r) {
+    held[r].assign(all.begin() + disp[r], all.begin() + disp[r] + counts[r]);
+    std::sort(held[r].begin(), held[r].end());
+  }
+  for (std::size_t k = 0; k < g.size(); ++k) {
+    const int want = step_boxes.owner(mpm.grid().node_position(static_cast<LO>(g[k])));
+    const bool owned = static_cast<LO>(k) < mpm.owned_nodes();
+    const bool want_holds = std::binary_search(held[want].begin(), held[want].end(), static_cast<long long>(g[k]));
+    if (want == rank && !owned) ++bad[1];
+    if (owned && want != rank && want_holds) ++bad[1];
+  }
+  return bad;
+}
+
+}  // namespace
+
+TEST(MpmBoxes, DiagonalThrowAcrossBothCutsEqualsOneRank) {
+  auto world = Tpetra::getDefaultComm();
+  Teuchos::RCP<const Comm> self = Teuchos::rcp(new Teuchos::MpiComm<int>(MPI_COMM_SELF));
+  const int n = world->getSize(), rank = world->getRank();
+  Simulation<2> alone(diagonal_blocks(0.0), self);
+  const Result s = run_steps(alone, 40);
+  for (double above : {0.0, 1.1}) {
+    Simulation<2> dist(diagonal_blocks(above), world);
+    const auto& b = dist.mpm()->boxes();
+    if (n == 4) {
+      ASSERT_EQ(b.levels, 2);
+      ASSERT_EQ(b.parts[0] * b.parts[1], 4);
+    }
+    Result d = run_steps(dist, 39);
+    const auto last_step_boxes = dist.mpm()->boxes().mirror();
+    const Result d40 = run_steps(dist, 1);
+    d.iterations.insert(d.iterations.end(), d40.iterations.begin(), d40.iterations.end());
+    d.x = d40.x;
+    d.v = d40.v;
+    d.kinetic = d40.kinetic;
+    d.elastic = d40.elastic;
+    d.momentum = d40.momentum;
+    d.migrated = d40.migrated;
+    d.worst_imbalance = std::max(d.worst_imbalance, d40.worst_imbalance);
+    const std::string what = above > 0 ? "2D blocks in boxes, rebalanced" : "2D blocks in boxes";
+    compare<2>(*world, d, s, 1e-9, what);
+    if (n == 1) continue;
+    EXPECT_GT(d.migrated, 0) << what;
+    const auto bad = outside_own_box(*dist.mpm(), *world, last_step_boxes);
+    EXPECT_EQ(bad[0], 0) << what << ": rank " << rank << " holds particles of other boxes";
+    EXPECT_EQ(bad[1], 0) << what << ": rank " << rank << " owns nodes against their box";
+    if (above > 0) {
+      EXPECT_GE(dist.mpm()->rebalances(), 1) << what;
+      if (rank == 0)
+        std::cout << what << ": " << dist.mpm()->rebalances() << " rebalance(s), worst imbalance "
+                  << d.worst_imbalance << "; " << describe_boxes(dist.mpm()->boxes()) << "\n";
+    } else {
+      EXPECT_EQ(dist.mpm()->rebalances(), 0) << what;
+    }
+  }
+}
+
+TEST(MpmBoxes, CubeThrownAcrossTheBoxCutsEqualsOneRank3D) {
+  auto world = Tpetra::getDefaultComm();
+  Teuchos::RCP<const Comm> self = Teuchos::rcp(new Teuchos::MpiComm<int>(MPI_COMM_SELF));
+  auto setup = [] {
+    auto s = fixtures::cube_setup(Vec<3>(0.45, 0.45, 0.3), Vec<3>(0.3, 0.3, 0.3), 0.1, Vec<3>(0.0, 0.0, 0.0),
+                                  Vec<3>(1.2, 1.2, 0.8));
+    set_velocity<3>(s.mpm->particles, 0, s.mpm->particles.size(), Vec<3>(2.0, 1.5, 0.0));
+    s.gravity = {0.0, 0.0, -9.81};  // down z, along no cut
+    s.mpm->rebalance_above = 0.0;    // fixed boxes (the 2D test rebalances)
+    s.dt = 1e-2;
+    s.integrator = TimeIntegrator::backward_euler();
+    tight_cg(s);
+    return s;
+  };
+  Simulation<3> dist(setup(), world);
+  if (world->getSize() == 4) ASSERT_EQ(dist.mpm()->boxes().levels, 2);
+  const Result d = run_steps(dist, 8);
+  Simulation<3> alone(setup(), self);
+  const Result s = run_steps(alone, 8);
+  compare<3>(*world, d, s, 1e-9, "3D cube in boxes");
+  if (world->getSize() > 1) {
+    EXPECT_GT(d.migrated, 0);
+    EXPECT_EQ(dist.mpm()->rebalances(), 0);
+    const auto bad = outside_own_box(*dist.mpm(), *world, dist.mpm()->boxes().mirror());
+    EXPECT_EQ(bad[0], 0);
+    EXPECT_EQ(bad[1], 0);
+  }
+}
