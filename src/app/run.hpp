@@ -40,7 +40,7 @@ struct RunSummary {
   struct Spread {
     double min = 0, max = 0, mean = 0;
   };
-  Spread rank_assembly_s, rank_factor_s;  // assembly (less DofSpace::sum_seconds); factorisations
+  Spread rank_assembly_s, rank_factor_s;  // the terms' assembly kernels; factorisations
   long reuse_cg_iterations = 0;
   long stale_retries = 0;  // CG + BLOCK_CHOLMOD solves redone after the kept factor failed
   std::vector<std::pair<std::string, long>> graph_build_causes;  // DofSpace::build_causes (rank 0's)

@@ -195,6 +195,10 @@ void build_mpm(const Scene& scene, const std::vector<std::string>& mat_names, Si
   mpm.scheme = tr == "PIC" ? TransferScheme::PIC : tr == "FLIP" ? TransferScheme::FLIP : TransferScheme::APIC;
   mpm.extend_domain = m.get<std::string>("when particles leave") == "extend";
   mpm.rebalance_above = m.get<double>("rebalance above");
+  {
+    const auto bpa = m.get<Array<int>>("boxes per axis");
+    for (std::size_t d = 0; d < bpa.size() && d < 3; ++d) mpm.boxes_per_axis[d] = bpa[d];
+  }
   mpm.sort_every = m.get<int>("sort particles every");
   try {
     mpm.grid = grid_covering<dim>(vecd<dim>(m.get<Array<double>>("domain min"), "MPM/domain min"),

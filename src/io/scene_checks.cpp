@@ -104,6 +104,17 @@ void check_mpm(const ParameterList& raw, int dim) {
   const int ppc = m.get<int>("particles per cell");
   const bool ok = dim == 2 ? (ppc == 1 || ppc == 4 || ppc == 9 || ppc == 16) : (ppc == 1 || ppc == 8 || ppc == 27);
   if (!ok) bad("MPM/particles per cell", std::to_string(ppc), dim == 2 ? "1, 4, 9 or 16" : "1, 8 or 27");
+  const auto bpa = m.get<Array<int>>("boxes per axis");
+  if (!bpa.empty()) {
+    bool positive = static_cast<int>(bpa.size()) == dim;
+    for (const int b : bpa) positive = positive && b >= 1;
+    if (!positive) {
+      std::string v;
+      for (std::size_t k = 0; k < bpa.size(); ++k) v += (k ? ", " : "") + std::to_string(bpa[k]);
+      bad("MPM/boxes per axis", "[" + v + "]",
+          std::to_string(dim) + " whole numbers >= 1 whose product is the number of ranks (or no key)");
+    }
+  }
   const double rb = m.get<double>("rebalance above");
   if (!(rb == 0 || (rb > 1 && std::isfinite(rb))))
     bad("MPM/rebalance above", num(rb), "0 (never) or a finite imbalance > 1 (largest / mean particles per rank)");

@@ -196,8 +196,12 @@ Teuchos::RCP<const ParameterList> scene_schema() {
          "a particle whose B-spline stencil leaves the grid domain: stop with an error naming it and "
          "the step, or extend the grid by whole cells before the step",
          tuple<std::string>("error", "extend"));
+  mpm.set("boxes per axis", Array<int>(),
+          "MPI: the ranks' particle boxes along each axis ([x, y] or [x, y, z], each >= 1, their product the "
+          "number of ranks); empty: the rank count's prime factors to the axes with the most grid cells per "
+          "box (2 or 3 ranks: slabs along the axis with the most cells); not used on one rank");
   mpm.set("rebalance above", 1.2,
-          "MPI: new slab cuts when the ranks' particle counts reach largest / mean > this after a step "
+          "MPI: new box cuts when the ranks' particle counts reach largest / mean > this after a step "
           "(0: never; else > 1)");
   mpm.set("sort particles every", 0,
           "steps between reorders of the particles by grid cell, from step 1 (locality of the transfers and "

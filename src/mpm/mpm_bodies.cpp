@@ -164,7 +164,7 @@ void MpmBodies<dim>::replace_particles(const Particles<dim>& all) {
     resize_stencils();
     return;
   }
-  set_boxes(balanced_boxes(all, setup_.grid, comm_->getSize()));
+  set_boxes(balanced_boxes(all, setup_.grid, comm_->getSize(), setup_.boxes_per_axis));
   setup_.particles = select_box(all, boxes_, comm_->getRank(), ids_);
   resize_stencils();
 }

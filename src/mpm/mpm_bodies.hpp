@@ -44,6 +44,9 @@ struct MpmSetup {
   // more than rebalance_above x the mean particle count (0: never; scene key
   // 'MPM/rebalance above').
   double rebalance_above = 1.2;
+  // MPI: the ranks' boxes along each axis, their product the rank count
+  // (scene key 'MPM/boxes per axis'); all 0: automatic (box_layout).
+  std::array<int, 3> boxes_per_axis{0, 0, 0};
   // Particles reordered by cell (the base node of their B-spline stencil,
   // x fastest; within a cell by global id) at the start of steps 1,
   // 1 + sort_every, 1 + 2 sort_every, ..., so that neighbouring particles

@@ -199,22 +199,36 @@ std::vector<double> gather_rows(const double* rows, long long n_rows, int width,
 }  // namespace
 
 template <int dim>
-RankBoxes<dim> box_layout(const GridSpec<dim>& grid, int nranks) {
+RankBoxes<dim> box_layout(const GridSpec<dim>& grid, int nranks, const std::array<int, 3>& per_axis) {
   if (nranks < 1) throw std::invalid_argument("box_layout: " + std::to_string(nranks) + " ranks, expected >= 1");
-  std::vector<int> primes;
-  for (int n = nranks, f = 2; n > 1;) {
-    if (f * f > n) f = n;
-    while (n % f == 0) primes.push_back(f), n /= f;
-    ++f;
-  }
-  std::sort(primes.rbegin(), primes.rend());
   auto cells = [&](int d) { return static_cast<double>(std::max(grid.n_cells[d], 1)); };
   std::array<int, 3> parts{1, 1, 1};
-  for (const int f : primes) {
-    int best = 0;
-    for (int d = 1; d < dim; ++d)
-      if (cells(d) / parts[d] > cells(best) / parts[best]) best = d;
-    parts[best] *= f;
+  if (per_axis[0] > 0) {
+    long long product = 1;
+    std::string given;
+    for (int d = 0; d < dim; ++d) {
+      product *= per_axis[d];
+      given += (d ? ", " : "") + std::to_string(per_axis[d]);
+      parts[d] = per_axis[d];
+    }
+    if (product != nranks)
+      throw std::invalid_argument("scene key 'MPM/boxes per axis' = [" + given + "]: expected boxes whose product is "
+                                  "the number of ranks, " + std::to_string(nranks) +
+                                  " (or no key: the layout from the grid)");
+  } else {
+    std::vector<int> primes;
+    for (int n = nranks, f = 2; n > 1;) {
+      if (f * f > n) f = n;
+      while (n % f == 0) primes.push_back(f), n /= f;
+      ++f;
+    }
+    std::sort(primes.rbegin(), primes.rend());
+    for (const int f : primes) {
+      int best = 0;
+      for (int d = 1; d < dim; ++d)
+        if (cells(d) / parts[d] > cells(best) / parts[best]) best = d;
+      parts[best] *= f;
+    }
   }
   std::array<int, dim> order;
   for (int d = 0; d < dim; ++d) order[d] = d;
@@ -305,8 +319,9 @@ long long histogram_cuts(const long long* bins, int layers, int parts, double o,
 }  // namespace
 
 template <int dim>
-RankBoxes<dim> balanced_boxes(const Particles<dim>& all, const GridSpec<dim>& grid, int nranks) {
-  RankBoxes<dim> b = box_layout(grid, nranks);
+RankBoxes<dim> balanced_boxes(const Particles<dim>& all, const GridSpec<dim>& grid, int nranks,
+                              const std::array<int, 3>& per_axis) {
+  RankBoxes<dim> b = box_layout(grid, nranks, per_axis);
   auto x = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), all.x);
   auto h = Kokkos::create_mirror_view(b.cuts);
   std::vector<std::vector<std::size_t>> groups(1);
@@ -542,9 +557,9 @@ Kokkos::View<double*, MemSpace> particle_values_in_id_block(Kokkos::View<const d
 }
 
 #define BFEMP_INSTANTIATE(D)                                                                                        \
-  template RankBoxes<D> box_layout<D>(const GridSpec<D>&, int);                                                    \
+  template RankBoxes<D> box_layout<D>(const GridSpec<D>&, int, const std::array<int, 3>&);                         \
   template std::string describe_boxes<D>(const RankBoxes<D>&);                                                     \
-  template RankBoxes<D> balanced_boxes<D>(const Particles<D>&, const GridSpec<D>&, int);                           \
+  template RankBoxes<D> balanced_boxes<D>(const Particles<D>&, const GridSpec<D>&, int, const std::array<int, 3>&); \
   template RankBoxes<D> rebalanced_boxes<D>(const Particles<D>&, const RankBoxes<D>&, const GridSpec<D>&,          \
                                             const Teuchos::Comm<int>&, long long&);                                 \
   template Particles<D> select_box<D>(const Particles<D>&, const RankBoxes<D>&, int,                               \

@@ -35,6 +35,7 @@
 // one on 1 rank. One rank: nothing moves, ids are 0..n-1.
 #include <Kokkos_Core.hpp>
 #include <Teuchos_Comm.hpp>
+#include <array>
 #include <string>
 #include <vector>
 
@@ -104,9 +105,11 @@ struct RankBoxes {
   }
 };
 
-// The layout for nranks boxes over `grid` (see the file's comment).
+// The layout for nranks boxes over `grid` (see the file's comment), or, when
+// per_axis[0] > 0, per_axis[d] boxes along axis d (scene key 'MPM/boxes per
+// axis'; std::invalid_argument naming it unless their product is nranks).
 template <int dim>
-RankBoxes<dim> box_layout(const GridSpec<dim>& grid, int nranks);
+RankBoxes<dim> box_layout(const GridSpec<dim>& grid, int nranks, const std::array<int, 3>& per_axis = {0, 0, 0});
 
 // "slabs along axis 0, cuts at 0.5, 1 m" or "2 x 2 boxes: axis 0 cut at 0.5;
 // axis 1 cut at 0.3 | 0.4 m" (the banner of a run).
@@ -117,7 +120,8 @@ std::string describe_boxes(const RankBoxes<dim>& b);
 // part at every level (every rank passes the same `all`; no communication).
 // One-off host work (setup, restart).
 template <int dim>
-RankBoxes<dim> balanced_boxes(const Particles<dim>& all, const GridSpec<dim>& grid, int nranks);
+RankBoxes<dim> balanced_boxes(const Particles<dim>& all, const GridSpec<dim>& grid, int nranks,
+                              const std::array<int, 3>& per_axis = {0, 0, 0});
 
 // New cuts in old's layout at cell faces that split the particles of all
 // ranks (p: this rank's) into parts of about equal counts, level by level,

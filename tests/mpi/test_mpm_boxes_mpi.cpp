@@ -3,7 +3,7 @@
 // ranks:
 //   - the layout (host, any rank count): R's prime factors given to the axes
 //     with the most cells per part; 2 and 3 ranks stay slabs along the axis
-//     with the most cells (the layout before boxes);
+//     with the most cells (the layout before boxes); 'MPM/boxes per axis';
 //   - balanced_boxes on known particle sets: equal counts in every box, each
 //     slab with its own cuts, owner() the box the cuts give;
 //   - on 4 ranks (2 x 2 boxes): a 2D block thrown diagonally across both
@@ -113,6 +113,20 @@ TEST(RankBoxes, LayoutGivesTheRanksToTheAxesWithTheMostCellsPerPart) {
   EXPECT_EQ(b4.distance(2, 0), 1);
   EXPECT_EQ(b4.distance(3, 3), 0);
   EXPECT_THROW(box_layout<2>(grid_of<2>({20, 20, 1}), 0), std::invalid_argument);
+  // 'MPM/boxes per axis': slabs along y on 4 ranks; 2 x 3 x 1 on 6; a product
+  // other than the rank count refused, naming the key
+  const auto forced = box_layout<2>(grid_of<2>({20, 20, 1}), 4, {1, 4, 0});
+  EXPECT_EQ(forced.levels, 1);
+  EXPECT_EQ(forced.axis[0], 1);
+  EXPECT_EQ(forced.parts[0], 4);
+  EXPECT_EQ(parts_of(box_layout<3>(twist, 6, {2, 3, 1})), (std::array<int, 3>{2, 3, 1}));
+  EXPECT_EQ(box_layout<3>(twist, 6, {2, 3, 1}).axis[0], 1);  // the level with more parts first
+  try {
+    box_layout<2>(grid_of<2>({20, 20, 1}), 2, {2, 2, 0});
+    ADD_FAILURE() << "boxes for 4 ranks accepted on 2";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("'MPM/boxes per axis' = [2, 2]"), std::string::npos) << e.what();
+  }
 }
 
 // 2D: 40 x 40 particles in [0, 1]^2 on a 10 x 10 grid, 4 ranks: 2 x 2 boxes

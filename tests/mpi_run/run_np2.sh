@@ -84,7 +84,14 @@ set +e
 set -e
 [ $rc = 2 ] && grep -q "'Solver' = 'explicit'" "$work/explicit.log" || { echo "explicit scene on 2 ranks: exit $rc"; cat "$work/explicit.log"; exit 1; }
 [ ! -e "$work/explicit/bfemp.h5" ] || { echo "the refused explicit run wrote output"; exit 1; }
-echo "refusals on 2 ranks: direct solver, FEM-FEM contact, explicit scene (exit 2)"
+set +e
+"${mpi[@]}" -np 2 "$exe" run "$src/inputs/mpm_column.yaml" --output "$work/boxes" --set 'Linear Solver/type=CG' \
+  --set 'MPM/boxes per axis=[1, 1]' > "$work/boxes.log" 2>&1; rc=$?
+set -e
+[ $rc = 2 ] && grep -q "'MPM/boxes per axis' = \[1, 1\]" "$work/boxes.log" && grep -q "number of ranks, 2" "$work/boxes.log" \
+  || { echo "boxes for 1 rank on 2 ranks: exit $rc"; cat "$work/boxes.log"; exit 1; }
+[ ! -e "$work/boxes/bfemp.h5" ] || { echo "the refused boxes run wrote output"; exit 1; }
+echo "refusals on 2 ranks: direct solver, FEM-FEM contact, explicit scene, boxes for another rank count (exit 2)"
 # MPM bodies alone on 2 ranks.
 mcg=(--set 'Linear Solver/type=CG' --set 'Time/end time=0.2')
 "${mpi[@]}" -np 1 "$exe" run "$src/inputs/mpm_column.yaml" --output "$work/mpm1" "${mcg[@]}" > "$work/mpm1.log" 2>&1

@@ -194,6 +194,9 @@ bfemp:
   for (const char* v : {"1", "0.5", "-1"})
     expect_message(error_of(with("particles per cell: 4", std::string("particles per cell: 4\n    rebalance above: ") + v)),
                    {"MPM/rebalance above", v, "0 (never) or a finite imbalance > 1"});
+  for (const char* v : {"[0, 2]", "[2]", "[2, 2, 1]", "[-1, 4]"})
+    expect_message(error_of(with("particles per cell: 4", std::string("particles per cell: 4\n    boxes per axis: ") + v)),
+                   {"MPM/boxes per axis", v, "2 whole numbers >= 1 whose product is the number of ranks"});
   expect_message(error_of(with("particles per cell: 4", "particles per cell: 4\n    sort particles every: -2")),
                  {"MPM/sort particles every", "-2", "0 (never) or a number of steps >= 1"});
   expect_message(error_of(with("domain max: [1.0, 1.0]", "domain max: [1.0]")), {"MPM/domain max", "2 components"});
