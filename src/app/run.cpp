@@ -478,7 +478,7 @@ RunSummary run_scene(const Scene& scene, const std::string& dir, const Teuchos::
     log << "  particle sorts      " << s.particle_sorts << " (by grid cell, every " << s.sort_every << " steps)\n";
   if (s.mpm_ranks > 1)
     log << "  MPM on " << s.mpm_ranks << " ranks      " << s.migrations << " particle migrations, " << s.rebalances
-        << " slab rebalance(s); particle imbalance at the end " << std::setprecision(3) << s.imbalance
+        << " box rebalance(s); particle imbalance at the end " << std::setprecision(3) << s.imbalance
         << " (largest / mean per rank)\n";
   if (s.ranks > 1) {
     const auto digits = log.precision();

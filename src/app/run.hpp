@@ -49,7 +49,7 @@ struct RunSummary {
   long partial_projections = 0;  // fallbacks solved with a partial projection (Newton/fallback keep)
   long wolfe_steps = 0, wolfe_gradients = 0;  // Newton/line search: wolfe (NewtonStats)
   std::vector<std::pair<std::string, double>> term_assembly_s;  // per energy term
-  // MPI, MPM bodies in slabs: ranks, particle migrations, slab rebalances and
+  // MPI, MPM bodies in boxes: ranks, particle migrations, box rebalances and
   // the particle imbalance (largest / mean per rank) at the end.
   int mpm_ranks = 1, rebalances = 0;
   int ranks = 1;  // MPI ranks of the run

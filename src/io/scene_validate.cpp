@@ -41,7 +41,7 @@ std::string type_name(const Teuchos::ParameterEntry& e) {
 
 // Promotes integers given where reals are expected (YAML reads "1" as int),
 // 0 and 1 where a boolean is expected, and whole reals (2.0, 1e3) within
-// range where an integer is expected.
+// range where an integer is expected (also in lists, and the untyped []).
 void promote(ParameterList& list, const std::string& key, const Teuchos::ParameterEntry& want) {
   const auto& have = list.getEntry(key);
   if (want.isType<double>() && have.isType<int>()) {
@@ -49,6 +49,15 @@ void promote(ParameterList& list, const std::string& key, const Teuchos::Paramet
   } else if (want.isType<Array<double>>() && have.isType<Array<int>>()) {
     const auto ai = list.get<Array<int>>(key);
     list.set(key, Array<double>(ai.begin(), ai.end()));
+  } else if (want.isType<Array<int>>() && have.isType<Array<double>>()) {
+    // "[]" (typed as reals: the parser cannot type it) and whole reals: integers
+    const auto ad = list.get<Array<double>>(key);
+    Array<int> ai;
+    for (const double v : ad) {
+      if (!(v == std::floor(v) && std::abs(v) <= 2147483647.0)) return;
+      ai.push_back(static_cast<int>(v));
+    }
+    list.set(key, ai);
   } else if (want.isType<bool>() && have.isType<int>() && (list.get<int>(key) == 0 || list.get<int>(key) == 1)) {
     list.set(key, list.get<int>(key) == 1);
   } else if (want.isType<int>() && have.isType<double>()) {

@@ -203,7 +203,9 @@ RankBoxes<dim> box_layout(const GridSpec<dim>& grid, int nranks, const std::arra
   if (nranks < 1) throw std::invalid_argument("box_layout: " + std::to_string(nranks) + " ranks, expected >= 1");
   auto cells = [&](int d) { return static_cast<double>(std::max(grid.n_cells[d], 1)); };
   std::array<int, 3> parts{1, 1, 1};
-  if (per_axis[0] > 0) {
+  bool given_any = false, all_positive = true;
+  for (int d = 0; d < dim; ++d) given_any = given_any || per_axis[d] != 0, all_positive = all_positive && per_axis[d] >= 1;
+  if (given_any) {
     long long product = 1;
     std::string given;
     for (int d = 0; d < dim; ++d) {
@@ -211,9 +213,9 @@ RankBoxes<dim> box_layout(const GridSpec<dim>& grid, int nranks, const std::arra
       given += (d ? ", " : "") + std::to_string(per_axis[d]);
       parts[d] = per_axis[d];
     }
-    if (product != nranks)
+    if (!all_positive || product != nranks)
       throw std::invalid_argument("scene key 'MPM/boxes per axis' = [" + given + "]: expected boxes whose product is "
-                                  "the number of ranks, " + std::to_string(nranks) +
+                                  "the number of ranks, " + std::to_string(nranks) + ", each >= 1" +
                                   " (or no key: the layout from the grid)");
   } else {
     std::vector<int> primes;
@@ -278,7 +280,10 @@ std::string describe_boxes(const RankBoxes<dim>& b) {
 namespace {
 
 // Cuts of one group into `parts` along an axis from the group's sorted
-// coordinates: the nearest cell face to each quantile r / parts.
+// coordinates: the nearest cell face to each quantile r / parts. An empty
+// group gets -inf cuts (a particle entering it goes to its last part);
+// histogram_cuts puts an empty group's cuts at the grid's top face (its first
+// part). Either is deterministic and the same on every rank.
 void quantile_cuts(const std::vector<double>& sorted, int parts, double o, double dx, double* out) {
   double prev = -std::numeric_limits<double>::infinity();
   for (int r = 1; r < parts; ++r) {
@@ -333,7 +338,9 @@ RankBoxes<dim> balanced_boxes(const Particles<dim>& all, const GridSpec<dim>& gr
       std::vector<double> c;
       c.reserve(groups[g].size());
       for (const std::size_t q : groups[g]) c.push_back(x(q, a));
-      std::sort(c.begin(), c.end());
+      // NaN last (std::sort needs a strict weak order; the owner lookup puts NaN in part 0)
+      const auto finite_end = std::partition(c.begin(), c.end(), [](double v) { return !std::isnan(v); });
+      std::sort(c.begin(), finite_end);
       double* cut = h.data() + off + g * n;
       quantile_cuts(c, parts, grid.origin(a), grid.dx, cut);
       std::vector<std::vector<std::size_t>> children(parts);

@@ -106,8 +106,9 @@ struct RankBoxes {
 };
 
 // The layout for nranks boxes over `grid` (see the file's comment), or, when
-// per_axis[0] > 0, per_axis[d] boxes along axis d (scene key 'MPM/boxes per
-// axis'; std::invalid_argument naming it unless their product is nranks).
+// any of per_axis[0..dim) is not 0, per_axis[d] boxes along axis d (scene key
+// 'MPM/boxes per axis'; std::invalid_argument naming it unless each is >= 1
+// and their product is nranks).
 template <int dim>
 RankBoxes<dim> box_layout(const GridSpec<dim>& grid, int nranks, const std::array<int, 3>& per_axis = {0, 0, 0});
 

@@ -90,7 +90,7 @@ Simulation<dim>::Simulation(SimulationSetup<dim> setup, const Teuchos::RCP<const
         throw std::invalid_argument("level set '" + ls.name + "': 'slip: true' runs on 1 MPI rank in this version "
                                     "(this run has " + std::to_string(comm->getSize()) +
                                     " ranks): run it without mpirun or with -np 1, or make it no-slip");
-    // Each rank keeps the particles of its slab; the grid is shared. FEM
+    // Each rank keeps the particles of its box; the grid is shared. FEM
     // bodies: every rank holds the whole mesh and state (its nodes are local
     // everywhere, with their global ids) and assembles the elements Zoltan2
     // gives it; a node is owned by the lowest rank with an element on it.
@@ -510,7 +510,7 @@ StepReport Simulation<dim>::step() {
   prescribed_velocities(t1);
   if (mpm_) {
     mpm_->end_step(x, v, v_old);
-    mpm_->migrate();  // MPI: particles that left this rank's slab
+    mpm_->migrate();  // MPI: particles that left this rank's box
   }
   time_ = t1;
   ++step_;

@@ -181,7 +181,7 @@ class Simulation {
   // DOF of each local DOF, and the local copies of the step's inputs.
   Teuchos::RCP<const Comm> comm_;
   bool distributed_ = false;      // FEM bodies only, elements cut into the ranks
-  bool mpm_distributed_ = false;  // MPM bodies only, particles cut into slabs (MpmBodies::distribute)
+  bool mpm_distributed_ = false;  // MPM bodies only, particles cut into boxes (MpmBodies::distribute)
   FemPartition part_;
   std::unique_ptr<DeformationTerm<dim, dim + 1>> local_elasticity_;  // MPM + FEM: this rank's elements, global node ids
   std::vector<char> fem_owned_;                   // MPM + FEM on several ranks: FEM nodes owned here

@@ -80,7 +80,7 @@ void Simulation<dim>::restore(const SimulationState<dim>& s) {
   from_host(v_, s.fem_v, "fem_v");
   from_host(a_, s.fem_a, "fem_a");
   if (mpm_) {
-    // The checkpoint's whole particle set (MPI: each rank then keeps its slab).
+    // The checkpoint's whole particle set (MPI: each rank then keeps its box).
     const std::size_t np = s.mass.size();
     if (static_cast<long long>(np) != mpm_->total_particles())
       throw std::invalid_argument("restart: checkpoint field 'particle_mass' has " + std::to_string(np) +
@@ -103,7 +103,7 @@ void Simulation<dim>::restore(const SimulationState<dim>& s) {
     }
     g.dx = s.grid_dx;
     mpm_->restore_grid(g, s.grid_extensions);
-    mpm_->replace_particles(p);  // (MPI: slabs cut on the checkpoint's grid)
+    mpm_->replace_particles(p);  // (MPI: boxes cut on the checkpoint's grid)
     if (!s.particle_order.empty() && !mpm_->distributed()) mpm_->restore_order(s.particle_order);
   }
   time_ = s.time;

@@ -113,6 +113,13 @@ TEST(RankBoxes, LayoutGivesTheRanksToTheAxesWithTheMostCellsPerPart) {
   EXPECT_EQ(b4.distance(2, 0), 1);
   EXPECT_EQ(b4.distance(3, 3), 0);
   EXPECT_THROW(box_layout<2>(grid_of<2>({20, 20, 1}), 0), std::invalid_argument);
+  // 3 x 2 boxes: rank = 2 i + j; distance sums the digits' differences
+  const auto b6 = box_layout<2>(grid_of<2>({20, 20, 1}), 6, {3, 2, 0});
+  EXPECT_EQ(b6.distance(1, 2), 2);  // (0, 1) and (1, 0)
+  EXPECT_EQ(b6.distance(0, 5), 3);  // (0, 0) and (2, 1)
+  EXPECT_EQ(b6.distance(4, 1), 3);  // (2, 0) and (0, 1)
+  EXPECT_THROW(box_layout<2>(grid_of<2>({20, 20, 1}), 4, {4, -1, 0}), std::invalid_argument);
+  EXPECT_THROW(box_layout<2>(grid_of<2>({20, 20, 1}), 4, {0, 4, 0}), std::invalid_argument);
   // 'MPM/boxes per axis': slabs along y on 4 ranks; 2 x 3 x 1 on 6; a product
   // other than the rank count refused, naming the key
   const auto forced = box_layout<2>(grid_of<2>({20, 20, 1}), 4, {1, 4, 0});
@@ -151,6 +158,34 @@ TEST(RankBoxes, BalancedBoxesHoldEqualCountsAndEachSlabHasItsOwnCuts) {
   const auto b3 = balanced_boxes<3>(p3, grid_of<3>({10, 10, 10}), 8);
   EXPECT_EQ(counts<3>(p3, b3), std::vector<int>(8, 1000));
 
+  // 3D, three levels with distinct cuts: the lattice's z scaled by 1, 0.5,
+  // 0.25, 0.75 in the columns (x < 0.5, y < 0.5), (x < 0.5, y > 0.5),
+  // (x > 0.5, y < 0.5), (x > 0.5, y > 0.5): each column's median z (the
+  // particle at z = 0.525 s) at its nearest face: 0.5, 0.3, 0.1, 0.4.
+  Particles<3> r = lattice<3>(20);
+  {
+    auto xr = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), r.x);
+    for (std::size_t k = 0; k < xr.extent(0); ++k) {
+      const int i = xr(k, 0) > 0.5, j = xr(k, 1) > 0.5;
+      const double scale[2][2] = {{1.0, 0.5}, {0.25, 0.75}};
+      xr(k, 2) *= scale[i][j];
+    }
+    Kokkos::deep_copy(r.x, xr);
+  }
+  const auto br = balanced_boxes<3>(r, grid_of<3>({10, 10, 10}), 8);
+  ASSERT_EQ(br.levels, 3);
+  const auto hr = br.mirror();
+  ASSERT_EQ(hr.cuts.extent(0), 7u);  // 1 (x) + 2 (y, one per slab) + 4 (z, one per column)
+  ASSERT_EQ(br.level_offset(2), 3);
+  const double want_z[4] = {0.5, 0.3, 0.1, 0.4};
+  for (int k = 0; k < 3; ++k) EXPECT_NEAR(hr.cuts(k), 0.5, 1e-12) << k;
+  for (int g = 0; g < 4; ++g) EXPECT_NEAR(hr.cuts(3 + g), want_z[g], 1e-12) << "column " << g;
+  EXPECT_EQ(hr.owner(Vec<3>(0.7, 0.2, 0.15)), 5);  // column (1, 0), above its cut 0.1
+  EXPECT_EQ(hr.owner(Vec<3>(0.7, 0.2, 0.05)), 4);
+  EXPECT_EQ(hr.owner(Vec<3>(0.2, 0.7, 0.35)), 3);  // column (0, 1), above 0.3
+  EXPECT_EQ(hr.owner(Vec<3>(0.2, 0.7, 0.25)), 2);
+  EXPECT_EQ(hr.owner(Vec<3>(0.9, 0.9, 0.45)), 7);  // column (1, 1), above 0.4
+
   // Uneven: the left slab (x < 0.5) has its particles in y < 0.3 only.
   Particles<2> q = allocate_particles<2>(800);
   auto x = Kokkos::create_mirror_view(q.x);
@@ -170,6 +205,42 @@ TEST(RankBoxes, BalancedBoxesHoldEqualCountsAndEachSlabHasItsOwnCuts) {
   EXPECT_EQ(cu[2], 400 / 2);
   EXPECT_EQ(cu[3], 400 / 2);
   EXPECT_EQ(cu[0] + cu[1], 400);
+}
+
+// rebalanced_boxes from the histograms summed over the ranks, on known
+// particles spread over the ranks by index (grid [0, 1]^2, dx 0.1): 400 in
+// x < 0.5 with y in (0, 0.3) (140, 130, 130 in the three lowest cell
+// layers), 400 in x > 0.5 with y in (0, 1) (40 per layer). On 4 ranks
+// (2 x 2): the x cut at 0.5; each slab its own y cut, at the face whose count
+// below is nearest half the slab's: 0.1 (140 below) and 0.5; the largest box
+// 260 (the left slab's upper part).
+TEST(MpmBoxes, RebalancedCutsComeFromEachGroupsOwnHistogram) {
+  auto world = Tpetra::getDefaultComm();
+  const int me = world->getRank(), n = world->getSize();
+  std::vector<std::array<double, 2>> xs;
+  for (int k = 0; k < 800; ++k) {
+    const int c = k % 400;
+    const std::array<double, 2> x = k < 400 ? std::array<double, 2>{0.025 + 0.05 * (c % 10), 0.0075 * (c / 10) + 0.001}
+                                           : std::array<double, 2>{0.525 + 0.05 * (c % 10), 0.025 * (c / 10) + 0.001};
+    if (k % n == me) xs.push_back(x);
+  }
+  Particles<2> p = allocate_particles<2>(xs.size());
+  auto xh = Kokkos::create_mirror_view(p.x);
+  for (std::size_t q = 0; q < xs.size(); ++q) xh(q, 0) = xs[q][0], xh(q, 1) = xs[q][1];
+  Kokkos::deep_copy(p.x, xh);
+  const auto grid = grid_of<2>({10, 10, 1});
+  long long largest = 0;
+  const auto b = rebalanced_boxes<2>(p, box_layout<2>(grid, n), grid, *world, largest);
+  const auto h = b.mirror();
+  if (n == 1) {
+    EXPECT_EQ(largest, 800);
+  } else if (n == 4) {
+    ASSERT_EQ(h.cuts.extent(0), 3u);
+    EXPECT_NEAR(h.cuts(0), 0.5, 1e-12);
+    EXPECT_NEAR(h.cuts(1), 0.1, 1e-12);  // the left slab's
+    EXPECT_NEAR(h.cuts(2), 0.5, 1e-12);  // the right slab's
+    EXPECT_EQ(largest, 260);
+  }
 }
 
 namespace {

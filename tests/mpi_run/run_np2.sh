@@ -102,8 +102,12 @@ grep -q "MPM particles in slabs" "$work/mpm2.log" || { echo "no MPM slab line in
   || { echo "MPM restart on 2 ranks failed"; cat "$work/mpm2_restart.log"; exit 1; }
 # A 1-rank run (serial HDF5 file) continued on 2 ranks (the file reopened with MPI-IO).
 "${mpi[@]}" -np 1 "$exe" run "$src/inputs/mpm_column.yaml" --output "$work/mpm1_half" --set 'Linear Solver/type=CG' --set 'Time/end time=0.1' > "$work/mpm1_half.log" 2>&1
-"${mpi[@]}" -np 2 "$exe" restart "$work/mpm1_half" --set 'Time/end time=0.2' > "$work/mpm1_restart.log" 2>&1 \
+# (with the boxes chosen by hand: slabs along x instead of the column's y)
+"${mpi[@]}" -np 2 "$exe" restart "$work/mpm1_half" --set 'Time/end time=0.2' --set 'MPM/boxes per axis=[2, 1]' \
+  > "$work/mpm1_restart.log" 2>&1 \
   || { echo "a 1-rank MPM run restarted on 2 ranks failed"; cat "$work/mpm1_restart.log"; exit 1; }
+grep -q "MPM particles in slabs along axis 0" "$work/mpm1_restart.log" \
+  || { echo "the restart's boxes are not the ones asked for"; cat "$work/mpm1_restart.log"; exit 1; }
 /usr/bin/python3 - "$work/mpm1" "$work/mpm2" "$work/mpm2_half" "$work/mpm1_half" <<'PY'
 import sys, csv, h5py, numpy as np
 a, b, c, d1 = sys.argv[1:5]
