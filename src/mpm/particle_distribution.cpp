@@ -338,9 +338,10 @@ RankBoxes<dim> balanced_boxes(const Particles<dim>& all, const GridSpec<dim>& gr
       std::vector<double> c;
       c.reserve(groups[g].size());
       for (const std::size_t q : groups[g]) c.push_back(x(q, a));
-      // NaN last (std::sort needs a strict weak order; the owner lookup puts NaN in part 0)
-      const auto finite_end = std::partition(c.begin(), c.end(), [](double v) { return !std::isnan(v); });
-      std::sort(c.begin(), finite_end);
+      // NaN dropped (std::sort needs a strict weak order; the lookup below and
+      // owner() put NaN in part 0)
+      c.erase(std::remove_if(c.begin(), c.end(), [](double v) { return std::isnan(v); }), c.end());
+      std::sort(c.begin(), c.end());
       double* cut = h.data() + off + g * n;
       quantile_cuts(c, parts, grid.origin(a), grid.dx, cut);
       std::vector<std::vector<std::size_t>> children(parts);
@@ -379,9 +380,9 @@ RankBoxes<dim> rebalanced_boxes(const Particles<dim>& p, const RankBoxes<dim>& o
     Kokkos::parallel_for(
         "mpm_box_histogram", Kokkos::RangePolicy<ExecSpace>(0, p.size()), KOKKOS_LAMBDA(const LO q) {
           Vec<dim> xq;
-          for (int c = 0; c < dim; ++c) xq(c) = x(q, c);
-          const double c = std::floor((xq(a) - o) / dx);
-          const int k = !(c >= 0.0) ? 0 : c >= layers ? layers + 1 : 1 + static_cast<int>(c);  // NaN: bin 0
+          for (int d = 0; d < dim; ++d) xq(d) = x(q, d);
+          const double layer = std::floor((xq(a) - o) / dx);
+          const int k = !(layer >= 0.0) ? 0 : layer >= layers ? layers + 1 : 1 + static_cast<int>(layer);  // NaN: bin 0
           Kokkos::atomic_add(&hist(sd.group(xq, l) * width + k), 1LL);
         });
     auto h = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), hist);

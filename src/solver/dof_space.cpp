@@ -262,9 +262,7 @@ void DofSpace<dim>::end_assembly(MaskView prescribed, ConstDofView dx_prescribed
   b.doExport(*rhs_overlap_, *export_, Tpetra::ADD);
   A_->resumeFill();
   matrix_sum_->sum(*A_overlap_, *A_);
-  const double summed = timer.seconds();
-  sum_s_ += summed;
-  exchange_s_ += summed;
+  exchange_s_ += timer.seconds();
   exchange_bytes_ += 8.0 * (static_cast<double>(matrix_sum_->sent_values()) + export_->getNumExportIDs());
   // Constraint rows on the owned side (owned row r is local DOF owned_dofs(r)).
   auto lcl = A_->getLocalMatrixDevice();

@@ -139,9 +139,6 @@ class DofSpace {
   // owned ones, and to_local's import of owned values into the overlap
   // (waiting for the other ranks included). 0 on one rank.
   double exchange_seconds() const { return exchange_s_; }
-  // The part of it in the assembly: the overlap matrix and rhs summed into
-  // the owned ones (waiting for the slower ranks included).
-  double sum_seconds() const { return sum_s_; }
   // Bytes this rank has sent in those exchanges since construction (matrix
   // values and vector entries, 8 bytes each).
   double exchange_bytes() const { return exchange_bytes_; }
@@ -185,7 +182,7 @@ class DofSpace {
   void count_cause(const std::string& cause);
   Kokkos::View<int, MemSpace> dropped_;
   double graph_build_s_ = 0, graph_build_total_s_ = 0;
-  double exchange_s_ = 0, exchange_bytes_ = 0, sum_s_ = 0;
+  double exchange_s_ = 0, exchange_bytes_ = 0;
 };
 
 }  // namespace bfemp

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <functional>
 #include <iostream>
 #include <string>
 #include <vector>
@@ -25,11 +26,13 @@ struct Result {
   double worst_imbalance = 1.0;  // largest / mean particles per rank, the worst step end
 };
 
+// `steps` steps; before_step(s) before step s (0-based) when given.
 template <int dim>
-Result run_steps(Simulation<dim>& sim, int steps) {
+Result run_steps(Simulation<dim>& sim, int steps, const std::function<void(int)>& before_step = {}) {
   Result r;
   r.momentum0 = sim.diagnostics().momentum;
   for (int s = 0; s < steps; ++s) {
+    if (before_step) before_step(s);
     const StepReport rep = sim.step();
     r.iterations.push_back(rep.newton.iterations);
     r.kinetic = rep.kinetic;
@@ -84,6 +87,27 @@ void compare(const Comm& world, const Result& d, const Result& s, double x_tol, 
   EXPECT_NEAR(d.elastic, s.elastic, 1e-6 * std::max(s.elastic, 1e-12)) << what;
   std::cout << what << ", " << world.getSize() << " rank(s): |x - x_alone| = " << ex << " m, |v - v_alone| = " << ev
             << " m/s, " << d.migrated << " particle migrations\n";
+}
+
+// Two 0.3 x 0.3 MPM blocks (APIC, dx 0.05, 4 per cell) centred at a and b
+// on a grid covering [0, domain_max], bodies named `names`; the first moves
+// at `velocity`, the second rests. Backward Euler, dt 5e-3, tight_cg.
+inline SimulationSetup<2> two_mpm_blocks(Vec<2> a, Vec<2> b, Vec<2> domain_max, Vec<2> velocity,
+                                         std::vector<std::string> names) {
+  auto s = mpm_rect_setup(0.3, 0.3, a, 0.05, 4, Vec<2>(0.0, 0.0), domain_max, TransferScheme::APIC);
+  auto other = mpm_rect_setup(0.3, 0.3, b, 0.05, 4, Vec<2>(0.0, 0.0), domain_max, TransferScheme::APIC);
+  const std::size_t nl = s.mpm->particles.size();
+  s.mpm->particles = concatenate<2>({s.mpm->particles, other.mpm->particles});
+  auto body = s.mpm->particles.body;
+  Kokkos::parallel_for(
+      "test_body", Kokkos::RangePolicy<ExecSpace>(nl, s.mpm->particles.size()),
+      KOKKOS_LAMBDA(const std::size_t q) { body(q) = 1; });
+  s.mpm->body_names = std::move(names);
+  set_velocity<2>(s.mpm->particles, 0, nl, velocity);
+  s.dt = 5e-3;
+  s.integrator = TimeIntegrator::backward_euler();
+  tight_cg(s);
+  return s;
 }
 
 }  // namespace bfemp::fixtures

@@ -39,22 +39,8 @@ using fixtures::tight_cg;
 using fixtures::Result;
 
 SimulationSetup<2> two_blocks() {
-  auto s = fixtures::mpm_rect_setup(0.3, 0.3, Vec<2>(0.5, 0.4), 0.05, 4, Vec<2>(0.0, 0.0), Vec<2>(2.4, 0.8),
-                                    TransferScheme::APIC);
-  auto right = fixtures::mpm_rect_setup(0.3, 0.3, Vec<2>(1.3, 0.4), 0.05, 4, Vec<2>(0.0, 0.0), Vec<2>(2.4, 0.8),
-                                        TransferScheme::APIC);
-  const std::size_t nl = s.mpm->particles.size();
-  s.mpm->particles = concatenate<2>({s.mpm->particles, right.mpm->particles});
-  auto body = s.mpm->particles.body;
-  Kokkos::parallel_for(
-      "test_body", Kokkos::RangePolicy<ExecSpace>(nl, s.mpm->particles.size()),
-      KOKKOS_LAMBDA(const std::size_t q) { body(q) = 1; });
-  s.mpm->body_names = {"moving", "resting"};
-  set_velocity<2>(s.mpm->particles, 0, nl, Vec<2>(3.0, 0.0));
-  s.dt = 5e-3;
-  s.integrator = TimeIntegrator::backward_euler();
-  tight_cg(s);
-  return s;
+  return fixtures::two_mpm_blocks(Vec<2>(0.5, 0.4), Vec<2>(1.3, 0.4), Vec<2>(2.4, 0.8), Vec<2>(3.0, 0.0),
+                                  {"moving", "resting"});
 }
 
 }  // namespace
