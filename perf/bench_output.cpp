@@ -21,7 +21,10 @@
 //             and its von Mises and J the mass and volume (same bytes);
 //   bfemp_gather what `bfemp run` did before (up to 9758db7): the same
 //             particles gathered whole to rank 0 (gather_particles), which
-//             writes them with the serial Hdf5FrameWriter.
+//             writes them with the serial Hdf5FrameWriter;
+//   checkpoint, checkpoint_gather  a restart checkpoint of the same particles
+//             (224 bytes each), by id blocks through MPI-IO or gathered to
+//             rank 0 (see write_checkpoint_bench).
 // The file is written under --dir (default /tmp) and removed afterwards.
 //   mpirun -np P bench_output [--particles 1000000] [--repeats 3] [--dir /tmp] [--out output.json]
 #include <Kokkos_Core.hpp>
@@ -39,6 +42,7 @@
 #include <string>
 #include <vector>
 
+#include "io/checkpoint.hpp"
 #include "io/hdf5_frames.hpp"
 #include "mpm/particle_distribution.hpp"
 
@@ -181,12 +185,15 @@ double write_mpio(const std::string& path, long long N, int rank, int P, bool co
   return seconds_since(t0);
 }
 
-double write_bfemp(const std::string& path, long long N, int rank, int P, bool gather) {
+// Rank r's particles: ids r, r + P, r + 2P, ... (the worst case of a cut:
+// (P-1)/P of them leave for another rank's id block). Every field of particle
+// q is 1e-3 q + a per-field offset (x: +c, v: +c + 10, F: +3c + d + 20,
+// mass: +30, volume0: +40; body q mod 7).
+bfemp::Particles<3> scattered_particles(long long N, int rank, int P, Kokkos::View<long long*, bfemp::MemSpace>& ids) {
   using namespace bfemp;
-  const Teuchos::MpiComm<int> comm(MPI_COMM_WORLD);
   const long long mine = N / P + (rank < N % P ? 1 : 0);
   Particles<3> p = allocate_particles<3>(mine);
-  Kokkos::View<long long*, MemSpace> ids("ids", mine);
+  ids = Kokkos::View<long long*, MemSpace>("ids", mine);
   Kokkos::parallel_for(
       "bench_output_particles", Kokkos::RangePolicy<ExecSpace>(0, mine), KOKKOS_LAMBDA(const long long k) {
         const long long q = rank + k * P;
@@ -202,6 +209,14 @@ double write_bfemp(const std::string& path, long long N, int rank, int P, bool g
         p.body(k) = static_cast<int>(q % 7);
       });
   Kokkos::fence();
+  return p;
+}
+
+double write_bfemp(const std::string& path, long long N, int rank, int P, bool gather) {
+  using namespace bfemp;
+  const Teuchos::MpiComm<int> comm(MPI_COMM_WORLD);
+  Kokkos::View<long long*, MemSpace> ids;
+  const Particles<3> p = scattered_particles(N, rank, P, ids);
   MPI_Barrier(MPI_COMM_WORLD);
   const auto t0 = std::chrono::steady_clock::now();
   const Particles<3> b = gather ? gather_particles(p, ids, N, comm) : particles_in_id_block(p, ids, N, comm);
@@ -231,6 +246,62 @@ double write_bfemp(const std::string& path, long long N, int rank, int P, bool g
   w.close();
   MPI_Barrier(MPI_COMM_WORLD);
   return seconds_since(t0);
+}
+
+template <class V>
+std::vector<double> host_reals(const V& v) {
+  auto h = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), v);
+  return std::vector<double>(h.data(), h.data() + h.size());
+}
+
+// A restart checkpoint of the particles (what make_checkpoint in
+// src/app/run.cpp puts: x, v, mass, volume0, F, C, body, material; 224 bytes
+// per particle): checkpoint = each rank its id block (particles_in_id_block,
+// put_rows, write_checkpoint through MPI-IO, bfemp since 2026-12-07);
+// checkpoint_gather = gather_particles to rank 0, which writes the whole set
+// with the serial writer (bfemp before).
+double write_checkpoint_bench(const std::string& path, long long N, int rank, int P, bool gather) {
+  using namespace bfemp;
+  const Teuchos::MpiComm<int> comm(MPI_COMM_WORLD);
+  Kokkos::View<long long*, MemSpace> ids;
+  const Particles<3> p = scattered_particles(N, rank, P, ids);
+  MPI_Barrier(MPI_COMM_WORLD);
+  const auto t0 = std::chrono::steady_clock::now();
+  const Particles<3> b = gather ? gather_particles(p, ids, N, comm) : particles_in_id_block(p, ids, N, comm);
+  if (!gather || rank == 0) {
+    const auto first = static_cast<std::size_t>(gather ? 0 : id_block_begin(N, rank, P)),
+               total = static_cast<std::size_t>(N);
+    Checkpoint c;
+    c.dim = 3;
+    c.texts["scene_source"] = "bench_output";
+    c.put_rows("particle_x", host_reals(b.x), 3, first, total);
+    c.put_rows("particle_v", host_reals(b.v), 3, first, total);
+    c.put_rows("particle_mass", host_reals(b.mass), 1, first, total);
+    c.put_rows("particle_volume0", host_reals(b.volume0), 1, first, total);
+    c.put_rows("particle_F", host_reals(b.F), 9, first, total);
+    c.put_rows("particle_C", host_reals(b.C), 9, first, total);
+    auto body = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), b.body);
+    auto mat = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), b.material);
+    c.put_rows("particle_body", std::vector<long long>(body.data(), body.data() + body.size()), 1, first, total);
+    c.put_rows("particle_material", std::vector<long long>(mat.data(), mat.data() + mat.size()), 1, first, total);
+    write_checkpoint(path, c, gather ? MPI_COMM_NULL : MPI_COMM_WORLD);
+  }
+  MPI_Barrier(MPI_COMM_WORLD);
+  return seconds_since(t0);
+}
+
+bool verify_checkpoint(const std::string& path, long long N) {
+  const bfemp::Checkpoint c = bfemp::read_checkpoint(path);
+  const auto& v = c.real("particle_v", N);
+  const auto& F = c.real("particle_F", N);
+  const auto& body = c.ints("particle_body", N);
+  bool ok = true;
+  for (long long q = 0; ok && q < N; q += N / 97 + 1) {
+    for (int k = 0; k < 3; ++k) ok = ok && v[q * 3 + k] == 1e-3 * q + k + 10;
+    for (int k = 0; k < 9; ++k) ok = ok && F[q * 9 + k] == 1e-3 * q + k + 20;
+    ok = ok && body[q] == q % 7;
+  }
+  return ok;
 }
 
 // Rank 0 reads the file back and checks a few values of every field (the
@@ -281,21 +352,26 @@ int main(int argc, char** argv) {
     else if (a == "--out") out = argv[i + 1];
   }
   const std::string path = dir + "/bench_output_" + std::to_string(P) + ".h5";
-  const double bytes = 144.0 * N;
   std::string rows;
   int code = 0;
   try {
-    for (const char* s : {"gather", "mpio_coll", "mpio_ind", "bfemp", "bfemp_gather"}) {
+    for (const char* s :
+         {"gather", "mpio_coll", "mpio_ind", "bfemp", "bfemp_gather", "checkpoint", "checkpoint_gather"}) {
       double best = 1e300;
       const std::string w = s;
+      const bool ck = w.rfind("checkpoint", 0) == 0;
+      const double bytes = (ck ? 224.0 : 144.0) * N;
       for (int r = 0; r < repeats; ++r) {
         const double t = w == "gather"  ? write_gather(path, N, rank, P)
                          : w == "bfemp" || w == "bfemp_gather" ? write_bfemp(path, N, rank, P, w != "bfemp")
+                         : ck ? write_checkpoint_bench(path, N, rank, P, w != "checkpoint")
                                         : write_mpio(path, N, rank, P, w == "mpio_coll");
         best = std::min(best, t);
       }
       bool ok = true;
-      if (rank == 0) ok = verify(path, N, w.rfind("bfemp", 0) == 0 ? bfemp::Hdf5FrameWriter::frame_group_name(0) + "/" : "");
+      if (rank == 0)
+        ok = ck ? verify_checkpoint(path, N)
+                : verify(path, N, w.rfind("bfemp", 0) == 0 ? bfemp::Hdf5FrameWriter::frame_group_name(0) + "/" : "");
       if (rank == 0) {
         std::remove(path.c_str());
         std::printf("%-10s %d rank(s), %lld particles: %.3f s per frame (%.0f MB/s)%s\n", s, P, N, best,

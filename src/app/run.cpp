@@ -78,14 +78,18 @@ Checkpoint make_checkpoint(const Scene& scene, const RunOptions& opt, const Simu
   c.put("fem_v", st.fem_v, dim);
   c.put("fem_a", st.fem_a, dim);
   if (st.has_mpm) {
-    c.put("particle_x", st.x, dim);
-    c.put("particle_v", st.v, dim);
-    c.put("particle_mass", st.mass);
-    c.put("particle_volume0", st.volume0);
-    c.put("particle_F", st.F, dim * dim);
-    c.put("particle_C", st.C, dim * dim);
-    c.put("particle_body", st.body);
-    c.put("particle_material", st.material);
+    // This rank's id block of every particle field (MPI-IO: one file, no
+    // gather); the rest is replicated, written by rank 0.
+    const std::size_t first = static_cast<std::size_t>(st.particle_first),
+                      total = static_cast<std::size_t>(st.particle_total);
+    c.put_rows("particle_x", st.x, dim, first, total);
+    c.put_rows("particle_v", st.v, dim, first, total);
+    c.put_rows("particle_mass", st.mass, 1, first, total);
+    c.put_rows("particle_volume0", st.volume0, 1, first, total);
+    c.put_rows("particle_F", st.F, dim * dim, first, total);
+    c.put_rows("particle_C", st.C, dim * dim, first, total);
+    c.put_rows("particle_body", st.body, 1, first, total);
+    c.put_rows("particle_material", st.material, 1, first, total);
     if (!st.particle_order.empty()) c.put("particle_order", st.particle_order);
     c.put("grid_origin", std::vector<double>(st.grid_origin.begin(), st.grid_origin.end()));
     c.put("grid_cells", std::vector<long long>(st.grid_cells.begin(), st.grid_cells.end()));
@@ -123,14 +127,26 @@ SimulationState<dim> checkpoint_state(const Checkpoint& c) {
   st.fem_a = c.real("fem_a");
   st.has_mpm = c.has("particle_x");
   if (st.has_mpm) {
-    st.x = c.real("particle_x");
-    st.v = c.real("particle_v");
-    st.mass = c.real("particle_mass");
-    st.volume0 = c.real("particle_volume0");
-    st.F = c.real("particle_F");
-    st.C = c.real("particle_C");
-    st.body = c.ints("particle_body");
-    st.material = c.ints("particle_material");
+    // This rank's rows (read_checkpoint's block; every row from a checkpoint
+    // written before row blocks), the same block of every field.
+    const CheckpointArray& m = c.array("particle_mass");
+    const long rows = static_cast<long>(m.rows);
+    st.particle_block = m.blocked;
+    st.particle_first = static_cast<long long>(m.first_row);
+    st.particle_total = static_cast<long long>(m.total_rows);
+    for (const char* name : {"particle_x", "particle_v", "particle_volume0", "particle_F", "particle_C",
+                             "particle_body", "particle_material"})
+      if (c.array(name).blocked != m.blocked || c.array(name).first_row != m.first_row)
+        throw std::invalid_argument(std::string("restart: checkpoint field '") + name +
+                                    "' is not cut into the same rows as 'particle_mass'");
+    st.x = c.real("particle_x", rows);
+    st.v = c.real("particle_v", rows);
+    st.mass = m.real;
+    st.volume0 = c.real("particle_volume0", rows);
+    st.F = c.real("particle_F", rows);
+    st.C = c.real("particle_C", rows);
+    st.body = c.ints("particle_body", rows);
+    st.material = c.ints("particle_material", rows);
     if (c.has("particle_order")) st.particle_order = c.ints("particle_order");
     const auto& o = c.real("grid_origin", dim);
     const auto& n = c.ints("grid_cells", dim);
@@ -234,9 +250,9 @@ RunSummary run_dim(const Scene& scene, const std::string& dir, const Teuchos::RC
   if (opt.restart && opt.append) resume = {opt.restart->frames, opt.restart->step};
   // A new output must not keep an older run's checkpoint: restarting from it
   // would mix that run's state with this run's frames.
-  // MPI: every rank writes its id block of the particles into bfemp.h5
-  // (MPI-IO; the FEM state is replicated and rank 0 writes it), rank 0 the
-  // text files; checkpoints gather the particles to rank 0, which writes them.
+  // MPI: every rank writes its id block of the particles into bfemp.h5 and
+  // checkpoint.h5 (MPI-IO; the FEM state is replicated and rank 0 writes it),
+  // rank 0 the text files.
   if (root && !(opt.restart && opt.append)) std::filesystem::remove(dir + "/checkpoint.h5");
   if (comm->getSize() > 1) comm->barrier();  // the old checkpoint is gone before any rank goes on
   const MPI_Comm out_comm = comm->getSize() > 1 ? raw_mpi_comm(*comm) : MPI_COMM_NULL;
@@ -248,10 +264,10 @@ RunSummary run_dim(const Scene& scene, const std::string& dir, const Teuchos::RC
   RunSummary s;
   s.contact = sim.contact() != nullptr;
   Kokkos::Timer output_timer;
-  auto checkpoint = [&] {  // collective (MPI MPM: the particles gathered to rank 0)
+  auto checkpoint = [&] {  // collective (MPI-IO: each rank its id block of the particles)
     output_timer.reset();
     const Checkpoint c = make_checkpoint(scene, opt, sim, out.frames_written());
-    if (root) write_checkpoint(ck_path, c);
+    write_checkpoint(ck_path, c, out_comm);
     s.checkpoints++;
     s.output_s += output_timer.seconds();
   };

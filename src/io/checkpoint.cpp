@@ -1,7 +1,6 @@
 #include "io/checkpoint.hpp"
 
 #include <fcntl.h>
-#include <hdf5.h>
 #include <unistd.h>
 
 #include <cerrno>
@@ -9,101 +8,79 @@
 #include <cstring>
 #include <filesystem>
 #include <stdexcept>
+#include <type_traits>
+
+#include "io/hdf5_util.hpp"
 
 namespace bfemp {
 
-void Checkpoint::put(const std::string& name, std::vector<double> v, std::size_t cols) {
+using h5::Handle;
+using h5::QuietErrors;
+
+namespace {
+
+template <class T>
+CheckpointArray make_array(std::vector<T> v, std::size_t cols, bool blocked, std::size_t first_row,
+                           std::size_t total_rows) {
   CheckpointArray a;
   a.cols = cols;
   a.rows = cols ? v.size() / cols : 0;
-  a.real = std::move(v);
-  arrays[name] = std::move(a);
+  a.blocked = blocked;
+  a.first_row = first_row;
+  a.total_rows = blocked ? total_rows : a.rows;
+  if constexpr (std::is_same_v<T, double>) {
+    a.real = std::move(v);
+  } else {
+    a.integer = true;
+    a.ints = std::move(v);
+  }
+  if (blocked && first_row + a.rows > total_rows)
+    throw std::logic_error("checkpoint rows " + std::to_string(first_row) + ".." + std::to_string(first_row + a.rows) +
+                           " of " + std::to_string(total_rows));
+  return a;
 }
 
+}  // namespace
+
+void Checkpoint::put(const std::string& name, std::vector<double> v, std::size_t cols) {
+  arrays[name] = make_array(std::move(v), cols, false, 0, 0);
+}
 void Checkpoint::put(const std::string& name, std::vector<long long> v, std::size_t cols) {
-  CheckpointArray a;
-  a.cols = cols;
-  a.rows = cols ? v.size() / cols : 0;
-  a.integer = true;
-  a.ints = std::move(v);
-  arrays[name] = std::move(a);
+  arrays[name] = make_array(std::move(v), cols, false, 0, 0);
+}
+void Checkpoint::put_rows(const std::string& name, std::vector<double> v, std::size_t cols, std::size_t first_row,
+                          std::size_t total_rows) {
+  arrays[name] = make_array(std::move(v), cols, true, first_row, total_rows);
+}
+void Checkpoint::put_rows(const std::string& name, std::vector<long long> v, std::size_t cols,
+                          std::size_t first_row, std::size_t total_rows) {
+  arrays[name] = make_array(std::move(v), cols, true, first_row, total_rows);
+}
+
+const CheckpointArray& Checkpoint::array(const std::string& name) const {
+  const auto it = arrays.find(name);
+  if (it == arrays.end())
+    throw std::invalid_argument("checkpoint field '" + name + "' is missing: the checkpoint does not match the scene");
+  return it->second;
 }
 
 namespace {
 
 const CheckpointArray& field(const Checkpoint& c, const std::string& name, long rows, bool integer) {
-  const auto it = c.arrays.find(name);
-  if (it == c.arrays.end())
-    throw std::invalid_argument("checkpoint field '" + name + "' is missing: the checkpoint does not match the scene");
-  if (it->second.integer != integer)
-    throw std::invalid_argument("checkpoint field '" + name + "' has the wrong type");
-  if (rows >= 0 && static_cast<long>(it->second.rows) != rows)
-    throw std::invalid_argument("checkpoint field '" + name + "' has " + std::to_string(it->second.rows) +
-                                " rows, expected " + std::to_string(rows) +
-                                " (the scene does not produce the checkpoint's state)");
-  return it->second;
-}
-
-// Owning hid_t.
-struct H {
-  hid_t id;
-  herr_t (*close)(hid_t);
-  ~H() {
-    if (id >= 0) close(id);
-  }
-};
-
-class Quiet {
- public:
-  Quiet() {
-    H5Eget_auto2(H5E_DEFAULT, &f_, &d_);
-    H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
-  }
-  ~Quiet() { H5Eset_auto2(H5E_DEFAULT, f_, d_); }
-
- private:
-  H5E_auto2_t f_ = nullptr;
-  void* d_ = nullptr;
-};
-
-hid_t ok(hid_t v, const std::string& file, const std::string& what) {
-  if (v < 0) throw std::runtime_error("checkpoint '" + file + "': " + what);
-  return v;
-}
-
-hid_t fapl_no_locking() {
-  const hid_t fapl = H5Pcreate(H5P_FILE_ACCESS);
-#if H5_VERSION_GE(1, 10, 7)
-  if (fapl >= 0) H5Pset_file_locking(fapl, 0, 1);
-#endif
-  return fapl;
-}
-
-void write_array(hid_t g, const std::string& file, const std::string& name, hid_t file_type, hid_t mem_type,
-                 const void* data, std::size_t rows, std::size_t cols) {
-  const std::string what = "cannot write '" + name + "'";
-  const hsize_t dims[2] = {rows, cols};
-  H space{ok(H5Screate_simple(cols == 1 ? 1 : 2, dims, nullptr), file, what), H5Sclose};
-  H d{ok(H5Dcreate2(g, name.c_str(), file_type, space.id, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), file, what),
-      H5Dclose};
-  if (rows * cols > 0) ok(H5Dwrite(d.id, mem_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, data), file, what);
-}
-
-template <class T>
-void write_attr(hid_t g, const std::string& file, const char* name, hid_t file_type, hid_t mem_type, T value) {
-  const std::string what = "cannot write attribute '" + std::string(name) + "'";
-  H space{ok(H5Screate(H5S_SCALAR), file, what), H5Sclose};
-  H a{ok(H5Acreate2(g, name, file_type, space.id, H5P_DEFAULT, H5P_DEFAULT), file, what), H5Aclose};
-  ok(H5Awrite(a.id, mem_type, &value), file, what);
+  const CheckpointArray& a = c.array(name);
+  if (a.integer != integer) throw std::invalid_argument("checkpoint field '" + name + "' has the wrong type");
+  if (rows >= 0 && static_cast<long>(a.rows) != rows)
+    throw std::invalid_argument("checkpoint field '" + name + "' has " + std::to_string(a.rows) + " rows, expected " +
+                                std::to_string(rows) + " (the scene does not produce the checkpoint's state)");
+  return a;
 }
 
 template <class T>
 T read_attr(hid_t g, const std::string& file, const char* name, hid_t mem_type) {
   T v{};
-  H a{H5Aopen(g, name, H5P_DEFAULT), H5Aclose};
-  if (a.id < 0 || H5Aread(a.id, mem_type, &v) < 0)
-    throw std::invalid_argument("checkpoint '" + file + "': attribute '" + name +
-                                "' missing: not a bfemp checkpoint");
+  Handle a(H5Aopen(g, name, H5P_DEFAULT), H5Aclose);
+  if (a.get() < 0 || H5Aread(a.get(), mem_type, &v) < 0)
+    throw std::invalid_argument("checkpoint '" + file + "': attribute '" + name + "' missing: not a bfemp checkpoint");
   return v;
 }
 
@@ -132,73 +109,97 @@ const std::vector<long long>& Checkpoint::ints(const std::string& name, long row
 
 namespace {
 
-void write_unsynced(const std::string& tmp, const Checkpoint& c) {
-  {
-    Quiet quiet;
-    H fapl{fapl_no_locking(), H5Pclose};
-    H f{ok(H5Fcreate(tmp.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, fapl.id), tmp, "cannot create"), H5Fclose};
-    H g{ok(H5Gcreate2(f.id, "/checkpoint", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), tmp, "cannot create group"),
-        H5Gclose};
-    write_attr(g.id, tmp, "format", H5T_STD_I64LE, H5T_NATIVE_LLONG, Checkpoint::kFormat);
-    write_attr(g.id, tmp, "time", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, c.time);
-    write_attr(g.id, tmp, "step", H5T_STD_I64LE, H5T_NATIVE_LLONG, static_cast<long long>(c.step));
-    write_attr(g.id, tmp, "frames", H5T_STD_I64LE, H5T_NATIVE_LLONG, static_cast<long long>(c.frames));
-    write_attr(g.id, tmp, "dim", H5T_STD_I64LE, H5T_NATIVE_LLONG, static_cast<long long>(c.dim));
-    {
-      H t{ok(H5Gcreate2(g.id, "text", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), tmp, "cannot create group"), H5Gclose};
-      for (const auto& [name, text] : c.texts)
-        write_array(t.id, tmp, name, H5T_STD_U8LE, H5T_NATIVE_UCHAR, text.data(), text.size(), 1);
-    }
-    for (const auto& [name, a] : c.arrays) {
-      if (name == "text") throw std::logic_error("checkpoint field name 'text' is reserved");
-      if (a.integer)
-        write_array(g.id, tmp, name, H5T_STD_I64LE, H5T_NATIVE_LLONG, a.ints.data(), a.rows, a.cols);
-      else
-        write_array(g.id, tmp, name, H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, a.real.data(), a.rows, a.cols);
-    }
-    ok(H5Fflush(f.id, H5F_SCOPE_GLOBAL), tmp, "flush failed");
-    H5Gclose(g.id);
-    g.id = -1;
-    const hid_t file = f.id;
-    f.id = -1;
-    ok(H5Fclose(file), tmp, "close failed");
+// Collective over comm (MPI_COMM_NULL: serial). Each object is created by
+// every rank in the same order (std::map order), each failure agreed on.
+void write_unsynced(const std::string& tmp, const Checkpoint& c, MPI_Comm comm, int rank) {
+  QuietErrors quiet;
+  std::string error;
+  hid_t file = -1;
+  try {
+    Handle fapl(h5::make_fapl(tmp, comm), H5Pclose);
+    file = h5::check(H5Fcreate(tmp.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, fapl.get()), tmp, "cannot create");
+  } catch (const std::exception& e) {
+    error = e.what();
   }
+  h5::agree(comm, tmp, error, "create");
+  Handle f(file, H5Fclose);
+  Handle g(h5::check(H5Gcreate2(f.get(), "/checkpoint", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), tmp,
+                     "cannot create group '/checkpoint'"),
+           H5Gclose);
+  const long long format = Checkpoint::kFormat, step = c.step, frames = c.frames, dim = c.dim;
+  h5::write_scalar_attribute(g.get(), "format", H5T_STD_I64LE, H5T_NATIVE_LLONG, &format, tmp, "/checkpoint");
+  h5::write_scalar_attribute(g.get(), "time", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, &c.time, tmp, "/checkpoint");
+  h5::write_scalar_attribute(g.get(), "step", H5T_STD_I64LE, H5T_NATIVE_LLONG, &step, tmp, "/checkpoint");
+  h5::write_scalar_attribute(g.get(), "frames", H5T_STD_I64LE, H5T_NATIVE_LLONG, &frames, tmp, "/checkpoint");
+  h5::write_scalar_attribute(g.get(), "dim", H5T_STD_I64LE, H5T_NATIVE_LLONG, &dim, tmp, "/checkpoint");
+  {
+    Handle t(h5::check(H5Gcreate2(g.get(), "text", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), tmp,
+                       "cannot create group '/checkpoint/text'"),
+             H5Gclose);
+    for (const auto& [name, text] : c.texts)
+      h5::write_dataset(t.get(), comm, rank, tmp, "/checkpoint/text", name, H5T_STD_U8LE, H5T_NATIVE_UCHAR,
+                        text.data(), text.size(), 0, text.size(), 1, true);
+  }
+  for (const auto& [name, a] : c.arrays) {
+    if (name == "text") throw std::logic_error("checkpoint field name 'text' is reserved");
+    const void* data = a.integer ? static_cast<const void*>(a.ints.data()) : a.real.data();
+    h5::write_dataset(g.get(), comm, rank, tmp, "/checkpoint", name, a.integer ? H5T_STD_I64LE : H5T_IEEE_F64LE,
+                      a.integer ? H5T_NATIVE_LLONG : H5T_NATIVE_DOUBLE, data, a.rows, a.first_row, a.total_rows,
+                      a.cols, !a.blocked);
+    if (a.blocked) {
+      const long long one = 1;
+      h5::write_scalar_attribute(g.get(), "blocked", H5T_STD_I64LE, H5T_NATIVE_LLONG, &one, tmp,
+                                 "/checkpoint/" + name, name.c_str());
+    }
+  }
+  h5::check(H5Fflush(f.get(), H5F_SCOPE_GLOBAL), tmp, "flush failed");
+  H5Gclose(g.release());
+  h5::check(H5Fclose(f.release()), tmp, "close failed");
 }
 
 }  // namespace
 
-void write_checkpoint(const std::string& path, const Checkpoint& c) {
+void write_checkpoint(const std::string& path, const Checkpoint& c, MPI_Comm comm) {
+  int rank = 0;
+  comm = h5::parallel_comm(comm, rank);
   const std::string tmp = path + ".tmp";
+  std::string error;
   try {
-    write_unsynced(tmp, c);
-    fsync_path(tmp);
-  } catch (...) {
-    std::remove(tmp.c_str());  // a failed write (disk full, ...) leaves the old checkpoint and no .tmp
-    throw;
+    write_unsynced(tmp, c, comm, rank);
+    if (rank == 0) fsync_path(tmp);
+  } catch (const std::exception& e) {
+    error = e.what();
+    if (error.empty()) error = "checkpoint '" + path + "': write failed";
   }
-  if (std::rename(tmp.c_str(), path.c_str()) != 0) {
-    const std::string err = std::strerror(errno);
-    std::remove(tmp.c_str());
-    throw std::runtime_error("checkpoint '" + path + "': rename from " + tmp + " failed (" + err + ")");
+  if (!error.empty() && rank == 0) std::remove(tmp.c_str());  // the old checkpoint stays; no .tmp is left
+  h5::agree(comm, tmp, error, "the checkpoint write");
+  if (rank == 0) {
+    if (std::rename(tmp.c_str(), path.c_str()) != 0) {
+      error = "checkpoint '" + path + "': rename from " + tmp + " failed (" + std::strerror(errno) + ")";
+      std::remove(tmp.c_str());
+    } else {
+      // The rename itself survives a power loss only once the directory is synced.
+      const std::string dir = std::filesystem::path(path).parent_path().string();
+      const int fd = ::open(dir.empty() ? "." : dir.c_str(), O_RDONLY | O_DIRECTORY);
+      if (fd >= 0) {
+        ::fsync(fd);
+        ::close(fd);
+      }
+    }
   }
-  // The rename itself survives a power loss only once the directory is synced.
-  const std::string dir = std::filesystem::path(path).parent_path().string();
-  const int fd = ::open(dir.empty() ? "." : dir.c_str(), O_RDONLY | O_DIRECTORY);
-  if (fd >= 0) {
-    ::fsync(fd);
-    ::close(fd);
-  }
+  h5::agree(comm, path, error, "the checkpoint rename");  // (every rank returns once the file is in place)
 }
 
-
 namespace {
-Checkpoint read_checkpoint_unchecked(const std::string& path);
+Checkpoint read_checkpoint_unchecked(const std::string& path, int rank, int nranks);
 }
 
 // Any failure to read the file is bad input (exit 2), naming the file.
-Checkpoint read_checkpoint(const std::string& path) {
+Checkpoint read_checkpoint(const std::string& path, int rank, int nranks) {
+  if (nranks < 1 || rank < 0 || rank >= nranks)
+    throw std::logic_error("read_checkpoint: rank " + std::to_string(rank) + " of " + std::to_string(nranks));
   try {
-    return read_checkpoint_unchecked(path);
+    return read_checkpoint_unchecked(path, rank, nranks);
   } catch (const std::invalid_argument&) {
     throw;
   } catch (const std::exception& e) {
@@ -207,66 +208,83 @@ Checkpoint read_checkpoint(const std::string& path) {
 }
 
 namespace {
-Checkpoint read_checkpoint_unchecked(const std::string& path) {
+Checkpoint read_checkpoint_unchecked(const std::string& path, int rank, int nranks) {
   if (!std::filesystem::is_regular_file(path))
     throw std::invalid_argument("checkpoint '" + path + "' does not exist (a run writes it at its end, on SIGINT/SIGTERM "
                                 "and every 'Output/checkpoint every' steps)");
-  Quiet quiet;
-  H fapl{fapl_no_locking(), H5Pclose};
-  H f{H5Fopen(path.c_str(), H5F_ACC_RDONLY, fapl.id), H5Fclose};
-  if (f.id < 0) throw std::invalid_argument("checkpoint '" + path + "' is not a readable HDF5 file");
-  H g{H5Gopen2(f.id, "/checkpoint", H5P_DEFAULT), H5Gclose};
-  if (g.id < 0) throw std::invalid_argument("checkpoint '" + path + "' has no /checkpoint group: not a bfemp checkpoint");
+  QuietErrors quiet;
+  Handle fapl(h5::make_fapl(path), H5Pclose);
+  Handle f(H5Fopen(path.c_str(), H5F_ACC_RDONLY, fapl.get()), H5Fclose);
+  if (f.get() < 0) throw std::invalid_argument("checkpoint '" + path + "' is not a readable HDF5 file");
+  Handle g(H5Gopen2(f.get(), "/checkpoint", H5P_DEFAULT), H5Gclose);
+  if (g.get() < 0)
+    throw std::invalid_argument("checkpoint '" + path + "' has no /checkpoint group: not a bfemp checkpoint");
   Checkpoint c;
-  const long long format = read_attr<long long>(g.id, path, "format", H5T_NATIVE_LLONG);
+  const long long format = read_attr<long long>(g.get(), path, "format", H5T_NATIVE_LLONG);
   if (format != Checkpoint::kFormat)
     throw std::invalid_argument("checkpoint '" + path + "' has format " + std::to_string(format) + ", expected " +
                                 std::to_string(Checkpoint::kFormat));
-  c.time = read_attr<double>(g.id, path, "time", H5T_NATIVE_DOUBLE);
-  c.step = static_cast<long>(read_attr<long long>(g.id, path, "step", H5T_NATIVE_LLONG));
-  c.frames = static_cast<int>(read_attr<long long>(g.id, path, "frames", H5T_NATIVE_LLONG));
-  c.dim = static_cast<int>(read_attr<long long>(g.id, path, "dim", H5T_NATIVE_LLONG));
-  // Lists the datasets of group `loc` and calls f(name, dataset id).
+  c.time = read_attr<double>(g.get(), path, "time", H5T_NATIVE_DOUBLE);
+  c.step = static_cast<long>(read_attr<long long>(g.get(), path, "step", H5T_NATIVE_LLONG));
+  c.frames = static_cast<int>(read_attr<long long>(g.get(), path, "frames", H5T_NATIVE_LLONG));
+  c.dim = static_cast<int>(read_attr<long long>(g.get(), path, "dim", H5T_NATIVE_LLONG));
+  // Lists the datasets of group `loc` and calls f(name).
   auto each = [&](hid_t loc, auto&& f) {
     H5G_info_t info;
-    ok(H5Gget_info(loc, &info), path, "cannot list a group");
+    h5::check(H5Gget_info(loc, &info), path, "cannot list a group");
     for (hsize_t i = 0; i < info.nlinks; ++i) {
       char name[256];
       const ssize_t len = H5Lget_name_by_idx(loc, ".", H5_INDEX_NAME, H5_ITER_INC, i, name, sizeof name, H5P_DEFAULT);
-      if (len < 0 || len >= static_cast<ssize_t>(sizeof name)) ok(-1, path, "bad field name");
+      if (len < 0 || len >= static_cast<ssize_t>(sizeof name)) h5::fail(path, "bad field name");
       if (std::string(name) != "text") f(std::string(name));  // the only subgroup
     }
   };
   auto read = [&](hid_t loc, const std::string& name, CheckpointArray& a, std::string* text) {
     const std::string what = "cannot read '" + name + "'";
-    H d{ok(H5Dopen2(loc, name.c_str(), H5P_DEFAULT), path, what), H5Dclose};
-    H space{ok(H5Dget_space(d.id), path, what), H5Sclose};
-    H type{ok(H5Dget_type(d.id), path, what), H5Tclose};
-    const int rank = H5Sget_simple_extent_ndims(space.id);
+    Handle d(h5::check(H5Dopen2(loc, name.c_str(), H5P_DEFAULT), path, what), H5Dclose);
+    Handle space(h5::check(H5Dget_space(d.get()), path, what), H5Sclose);
+    Handle type(h5::check(H5Dget_type(d.get()), path, what), H5Tclose);
+    const int ndims = H5Sget_simple_extent_ndims(space.get());
     hsize_t dims[2] = {0, 1};
-    if (rank < 1 || rank > 2 || H5Sget_simple_extent_dims(space.id, dims, nullptr) < 0) ok(-1, path, what);
-    const std::size_t n = static_cast<std::size_t>(dims[0] * (rank == 2 ? dims[1] : 1));
+    if (ndims < 1 || ndims > 2 || H5Sget_simple_extent_dims(space.get(), dims, nullptr) < 0) h5::fail(path, what);
+    const std::size_t cols = ndims == 2 ? dims[1] : 1;
     if (text) {
+      const std::size_t n = dims[0] * cols;
       text->assign(n, '\0');
-      if (n) ok(H5Dread(d.id, H5T_NATIVE_UCHAR, H5S_ALL, H5S_ALL, H5P_DEFAULT, text->data()), path, what);
+      if (n) h5::check(H5Dread(d.get(), H5T_NATIVE_UCHAR, H5S_ALL, H5S_ALL, H5P_DEFAULT, text->data()), path, what);
       return;
     }
-    a.rows = dims[0];
-    a.cols = rank == 2 ? dims[1] : 1;
-    a.integer = H5Tget_class(type.id) == H5T_INTEGER;
+    a.cols = cols;
+    a.total_rows = dims[0];
+    a.blocked = h5::check(H5Aexists(d.get(), "blocked"), path, what) > 0;
+    a.first_row = a.blocked ? a.total_rows * rank / nranks : 0;
+    a.rows = a.blocked ? a.total_rows * (rank + 1) / nranks - a.first_row : a.total_rows;
+    a.integer = H5Tget_class(type.get()) == H5T_INTEGER;
+    const std::size_t n = a.rows * cols;
+    void* out = nullptr;
     if (a.integer) {
       a.ints.resize(n);
-      if (n) ok(H5Dread(d.id, H5T_NATIVE_LLONG, H5S_ALL, H5S_ALL, H5P_DEFAULT, a.ints.data()), path, what);
+      out = a.ints.data();
     } else {
       a.real.resize(n);
-      if (n) ok(H5Dread(d.id, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, a.real.data()), path, what);
+      out = a.real.data();
     }
+    if (n == 0) return;
+    const hid_t mem_type = a.integer ? H5T_NATIVE_LLONG : H5T_NATIVE_DOUBLE;
+    if (a.rows == a.total_rows) {
+      h5::check(H5Dread(d.get(), mem_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, out), path, what);
+      return;
+    }
+    const hsize_t start[2] = {a.first_row, 0}, count[2] = {a.rows, cols};
+    h5::check(H5Sselect_hyperslab(space.get(), H5S_SELECT_SET, start, nullptr, count, nullptr), path, what);
+    Handle mem(h5::check(H5Screate_simple(ndims, count, nullptr), path, what), H5Sclose);
+    h5::check(H5Dread(d.get(), mem_type, mem.get(), space.get(), H5P_DEFAULT, out), path, what);
   };
-  each(g.id, [&](const std::string& name) { read(g.id, name, c.arrays[name], nullptr); });
-  H t{H5Gopen2(g.id, "text", H5P_DEFAULT), H5Gclose};
-  if (t.id >= 0) {
+  each(g.get(), [&](const std::string& name) { read(g.get(), name, c.arrays[name], nullptr); });
+  Handle t(H5Gopen2(g.get(), "text", H5P_DEFAULT), H5Gclose);
+  if (t.get() >= 0) {
     CheckpointArray unused;
-    each(t.id, [&](const std::string& name) { read(t.id, name, unused, &c.texts[name]); });
+    each(t.get(), [&](const std::string& name) { read(t.get(), name, unused, &c.texts[name]); });
   }
   return c;
 }

@@ -1,6 +1,6 @@
 #include "io/hdf5_frames.hpp"
 
-#include <hdf5.h>
+#include "io/hdf5_util.hpp"
 
 #include <cstdio>
 #include <stdexcept>
@@ -11,106 +11,10 @@ static_assert(std::is_same<hid_t, std::int64_t>::value, "hid_t is stored as std:
 namespace bfemp {
 namespace {
 
-// Suppresses HDF5's automatic error printing while alive, then restores it.
-class QuietErrors {
- public:
-  QuietErrors() {
-    H5Eget_auto2(H5E_DEFAULT, &func_, &data_);
-    H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
-  }
-  ~QuietErrors() { H5Eset_auto2(H5E_DEFAULT, func_, data_); }
-  QuietErrors(const QuietErrors&) = delete;
-  QuietErrors& operator=(const QuietErrors&) = delete;
-
- private:
-  H5E_auto2_t func_ = nullptr;
-  void* data_ = nullptr;
-};
-
-herr_t collect_error(unsigned n, const H5E_error2_t* err, void* out) {
-  std::string& s = *static_cast<std::string*>(out);
-  if (n > 0) s += "; ";
-  s += std::string(err->func_name ? err->func_name : "?") + ": " + (err->desc ? err->desc : "");
-  return 0;
-}
-
-// Must run before any other HDF5 call: each API call clears the stack.
-[[noreturn]] void fail(const std::string& file, const std::string& what) {
-  std::string stack;
-  H5Ewalk2(H5E_DEFAULT, H5E_WALK_DOWNWARD, collect_error, &stack);
-  throw std::runtime_error("HDF5 file '" + file + "': " + what +
-                           (stack.empty() ? std::string() : " [" + stack + "]"));
-}
-
-template <class T>
-T check(T value, const std::string& file, const std::string& what) {
-  if (value < 0) fail(file, what);
-  return value;
-}
-
-// Owning hid_t, closed with its matching H5?close.
-class Handle {
- public:
-  Handle(hid_t id, herr_t (*closer)(hid_t)) : id_(id), closer_(closer) {}
-  ~Handle() {
-    if (id_ >= 0) closer_(id_);
-  }
-  Handle(const Handle&) = delete;
-  Handle& operator=(const Handle&) = delete;
-  hid_t get() const { return id_; }
-
- private:
-  hid_t id_;
-  herr_t (*closer_)(hid_t);
-};
-
-// File access without HDF5 file locking (see the header), through MPI-IO on
-// `comm` unless it is MPI_COMM_NULL.
-hid_t make_fapl(const std::string& file, MPI_Comm comm = MPI_COMM_NULL) {
-  const hid_t fapl = check(H5Pcreate(H5P_FILE_ACCESS), file, "cannot create file access list");
-#if H5_VERSION_GE(1, 10, 7)
-  if (H5Pset_file_locking(fapl, 0, 1) < 0) {
-    H5Pclose(fapl);
-    fail(file, "cannot disable file locking");
-  }
-#endif
-  if (comm != MPI_COMM_NULL) {
-#ifdef H5_HAVE_PARALLEL
-    if (H5Pset_fapl_mpio(fapl, comm, MPI_INFO_NULL) < 0) {
-      H5Pclose(fapl);
-      fail(file, "cannot select the MPI-IO file driver");
-    }
-#else
-    H5Pclose(fapl);
-    throw std::runtime_error("HDF5 file '" + file +
-                             "': this HDF5 library has no MPI-IO driver; an MPI run needs parallel HDF5 "
-                             "(libhdf5-openmpi-dev)");
-#endif
-  }
-  return fapl;
-}
-
-// comm when it has more than one rank, else MPI_COMM_NULL (the serial driver).
-MPI_Comm parallel_comm(MPI_Comm comm, int& rank) {
-  rank = 0;
-  if (comm == MPI_COMM_NULL) return comm;
-  int size = 1;
-  MPI_Comm_size(comm, &size);
-  if (size <= 1) return MPI_COMM_NULL;
-  MPI_Comm_rank(comm, &rank);
-  return comm;
-}
-
-void write_scalar_attribute(hid_t loc, const char* name, hid_t file_type, hid_t mem_type,
-                            const void* value, const std::string& file,
-                            const std::string& object) {
-  const std::string what = "cannot write attribute '" + std::string(name) + "' of '" + object + "'";
-  Handle space(check(H5Screate(H5S_SCALAR), file, what), H5Sclose);
-  Handle attr(check(H5Acreate2(loc, name, file_type, space.get(), H5P_DEFAULT, H5P_DEFAULT),
-                    file, what),
-              H5Aclose);
-  check(H5Awrite(attr.get(), mem_type, value), file, what);
-}
+using h5::check;
+using h5::Handle;
+using h5::make_fapl;
+using h5::QuietErrors;
 
 // Read-only id of `file` (close with H5Fclose).
 hid_t open_read_only(const std::string& file) {
@@ -150,7 +54,7 @@ std::string Hdf5FrameWriter::frame_group_name(int index) {
 }
 
 Hdf5FrameWriter::Hdf5FrameWriter(const std::string& path, MPI_Comm comm)
-    : path_(path), comm_(parallel_comm(comm, rank_)) {
+    : path_(path), comm_(h5::parallel_comm(comm, rank_)) {
   QuietErrors quiet;
   Handle fapl(make_fapl(path_, comm_), H5Pclose);
   file_ = check(H5Fcreate(path_.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, fapl.get()), path_,
@@ -158,7 +62,7 @@ Hdf5FrameWriter::Hdf5FrameWriter(const std::string& path, MPI_Comm comm)
 }
 
 Hdf5FrameWriter::Hdf5FrameWriter(const std::string& path, int keep_frames, MPI_Comm comm)
-    : path_(path), comm_(parallel_comm(comm, rank_)) {
+    : path_(path), comm_(h5::parallel_comm(comm, rank_)) {
   QuietErrors quiet;
   Handle fapl(make_fapl(path_, comm_), H5Pclose);
   file_ = check(H5Fopen(path_.c_str(), H5F_ACC_RDWR, fapl.get()), path_, "cannot open for appending");
@@ -226,9 +130,9 @@ void Hdf5FrameWriter::begin_frame(int index, double time, long step) {
                  "cannot create group '" + name + "'");
   frame_name_ = name;
   const long long step64 = step, index64 = index;
-  write_scalar_attribute(frame_, "time", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, &time, path_, name);
-  write_scalar_attribute(frame_, "step", H5T_STD_I64LE, H5T_NATIVE_LLONG, &step64, path_, name);
-  write_scalar_attribute(frame_, "index", H5T_STD_I64LE, H5T_NATIVE_LLONG, &index64, path_, name);
+  h5::write_scalar_attribute(frame_, "time", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, &time, path_, name);
+  h5::write_scalar_attribute(frame_, "step", H5T_STD_I64LE, H5T_NATIVE_LLONG, &step64, path_, name);
+  h5::write_scalar_attribute(frame_, "index", H5T_STD_I64LE, H5T_NATIVE_LLONG, &index64, path_, name);
 }
 
 double Hdf5FrameWriter::frame_time(int index) const {
@@ -312,75 +216,12 @@ void Hdf5FrameWriter::write_static_rows(const std::string& name, const long long
   flush("/mesh/" + name);
 }
 
-void Hdf5FrameWriter::agree(const std::string& mine, const std::string& what) const {
-  if (!parallel()) {
-    if (!mine.empty()) throw std::runtime_error(mine);
-    return;
-  }
-  int ok = mine.empty() ? 1 : 0, all = 0;
-  MPI_Allreduce(&ok, &all, 1, MPI_INT, MPI_MIN, comm_);
-  if (all) return;
-  throw std::runtime_error(mine.empty() ? "HDF5 file '" + path_ + "': " + what + " failed on another MPI rank" : mine);
-}
-
-void Hdf5FrameWriter::write_dataset(std::int64_t loc, const std::string& loc_name,
-                                    const std::string& name, bool integer, const void* data,
-                                    std::size_t rows, std::size_t first_row, std::size_t total_rows,
-                                    std::size_t cols, bool replicated) {
-  const std::string full = loc_name + "/" + name;
-  const std::string what = "cannot write dataset '" + full + "'";
-  // Arguments checked, and (parallel) agreed on, before the collective create.
-  std::string bad_args;
-  try {
-    if (name.empty() || name.find('/') != std::string::npos || name == "." || name == "..")
-      throw std::invalid_argument("HDF5 file '" + path_ + "': dataset name '" + name +
-                                  "' in '" + loc_name + "': expected a non-empty name without '/'");
-    if (cols == 0 || (data == nullptr && rows > 0))
-      throw std::invalid_argument("HDF5 file '" + path_ + "': dataset '" + full + "' with " +
-                                  std::to_string(rows) + "x" + std::to_string(cols) +
-                                  (cols == 0 ? " values: expected cols >= 1" : " values and no data"));
-    if (first_row + rows > total_rows || (!parallel() && rows != total_rows))
-      throw std::invalid_argument("HDF5 file '" + path_ + "': dataset '" + full + "': rows " +
-                                  std::to_string(first_row) + ".." + std::to_string(first_row + rows) + " of " +
-                                  std::to_string(total_rows) +
-                                  (parallel() ? ": expected a block inside the dataset"
-                                              : ": expected every row (a serial writer writes whole datasets)"));
-  } catch (const std::invalid_argument& e) {
-    if (!parallel()) throw;
-    bad_args = e.what();
-  }
-  agree(bad_args, what);
-  std::string error;
-  try {
-    QuietErrors quiet;
-    if (check(H5Lexists(loc, name.c_str(), H5P_DEFAULT), path_, what) > 0)
-      throw std::runtime_error("HDF5 file '" + path_ + "': dataset '" + full + "' already exists");
-    const hsize_t dims[2] = {static_cast<hsize_t>(total_rows), static_cast<hsize_t>(cols)};
-    const int ndims = cols == 1 ? 1 : 2;
-    Handle space(check(H5Screate_simple(ndims, dims, nullptr), path_, what), H5Sclose);
-    const hid_t file_type = integer ? H5T_STD_I64LE : H5T_IEEE_F64LE;
-    const hid_t mem_type = integer ? H5T_NATIVE_LLONG : H5T_NATIVE_DOUBLE;
-    Handle dset(check(H5Dcreate2(loc, name.c_str(), file_type, space.get(), H5P_DEFAULT,
-                                 H5P_DEFAULT, H5P_DEFAULT),
-                      path_, what),
-                H5Dclose);
-    // Replicated data: rank 0 transfers them (independent I/O); the others
-    // only took part in the collective create.
-    const bool transfer = rows > 0 && !(replicated && rank_ != 0);
-    if (transfer && rows == total_rows) {
-      check(H5Dwrite(dset.get(), mem_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, data), path_, what);
-    } else if (transfer) {
-      const hsize_t start[2] = {static_cast<hsize_t>(first_row), 0};
-      const hsize_t count[2] = {static_cast<hsize_t>(rows), static_cast<hsize_t>(cols)};
-      check(H5Sselect_hyperslab(space.get(), H5S_SELECT_SET, start, nullptr, count, nullptr), path_, what);
-      Handle mem(check(H5Screate_simple(ndims, count, nullptr), path_, what), H5Sclose);
-      check(H5Dwrite(dset.get(), mem_type, mem.get(), space.get(), H5P_DEFAULT, data), path_, what);
-    }
-  } catch (const std::exception& e) {
-    error = e.what();
-    if (error.empty()) error = "HDF5 file '" + path_ + "': " + what;
-  }
-  agree(error, what);
+void Hdf5FrameWriter::write_dataset(std::int64_t loc, const std::string& loc_name, const std::string& name,
+                                    bool integer, const void* data, std::size_t rows, std::size_t first_row,
+                                    std::size_t total_rows, std::size_t cols, bool replicated) {
+  h5::write_dataset(loc, comm_, rank_, path_, loc_name, name, integer ? H5T_STD_I64LE : H5T_IEEE_F64LE,
+                    integer ? H5T_NATIVE_LLONG : H5T_NATIVE_DOUBLE, data, rows, first_row, total_rows, cols,
+                    replicated);
 }
 
 std::vector<double> read_dataset(const std::string& file, const std::string& path,

@@ -98,9 +98,6 @@ class Hdf5FrameWriter {
   void write_dataset(std::int64_t loc, const std::string& loc_name, const std::string& name,
                      bool integer, const void* data, std::size_t rows, std::size_t first_row,
                      std::size_t total_rows, std::size_t cols, bool replicated);
-  // Parallel: every rank learns whether all succeeded (throws `mine` where it
-  // failed, a message naming `what` elsewhere). Serial: rethrows `mine`.
-  void agree(const std::string& mine, const std::string& what) const;
   void close_handles() noexcept;
   std::int64_t mesh_group();  // "/mesh", created on first use
   std::int64_t frame_group(const std::string& dataset) const;  // throws if none open

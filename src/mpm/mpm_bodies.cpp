@@ -170,6 +170,38 @@ void MpmBodies<dim>::replace_particles(const Particles<dim>& all) {
 }
 
 template <int dim>
+void MpmBodies<dim>::replace_particle_block(const Particles<dim>& mine, long long first, long long total) {
+  if (!distributed_) {
+    if (first != 0 || static_cast<long long>(mine.size()) != total)
+      throw std::logic_error("MpmBodies::replace_particle_block: rows " + std::to_string(first) + ".. of " +
+                             std::to_string(total) + " on one rank");
+    replace_particles(mine);
+    return;
+  }
+  n_total_ = total;
+  setup_.particles = mine;
+  const std::size_t np = mine.size();
+  ids_ = Kokkos::View<long long*, MemSpace>("mpm_particle_ids", np);
+  auto ids = ids_;
+  Kokkos::parallel_for(
+      "mpm_ids_block", Kokkos::RangePolicy<ExecSpace>(0, np),
+      KOKKOS_LAMBDA(const std::size_t q) { ids(q) = first + static_cast<long long>(q); });
+  long long largest = 0;
+  const RankBoxes<dim> layout = box_layout(setup_.grid, comm_->getSize(), setup_.boxes_per_axis);
+  set_boxes(rebalanced_boxes(setup_.particles, layout, setup_.grid, *comm_, largest));
+  migrate_particles(setup_.particles, ids_, boxes_, *comm_, largest);
+  resize_stencils();
+}
+
+template <int dim>
+Particles<dim> MpmBodies<dim>::id_block_particles(long long& first) const {
+  first = 0;
+  if (!distributed_) return gathered_particles();
+  first = id_block_begin(n_total_, comm_->getRank(), comm_->getSize());
+  return particles_in_id_block(setup_.particles, ids_, n_total_, *comm_);
+}
+
+template <int dim>
 void MpmBodies<dim>::restore_order(const std::vector<long long>& order) {
   const std::size_t np = setup_.particles.size();
   if (distributed_) throw std::logic_error("MpmBodies::restore_order on several ranks");

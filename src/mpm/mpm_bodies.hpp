@@ -130,6 +130,12 @@ class MpmBodies {
   bool distributed() const { return distributed_; }
   // Restart: the whole particle set of a checkpoint (re-cut when distributed).
   void replace_particles(const Particles<dim>& all);
+  // Restart from this rank's id block of a checkpoint (ids first .. first +
+  // mine.size() - 1 of total; collective). Several ranks: boxes cut from the
+  // cell-layer counts summed over the ranks (rebalanced_boxes on the
+  // default layout) and every particle sent to its box, so no rank holds the
+  // whole set. One rank: mine is the whole set (std::logic_error otherwise).
+  void replace_particle_block(const Particles<dim>& mine, long long first, long long total);
   // Restart on one rank, after replace_particles: the checkpoint's particle
   // order (the id at each array position; std::invalid_argument unless it is
   // a permutation of 0..n-1).
@@ -158,6 +164,10 @@ class MpmBodies {
   // All particles in id order on rank 0 (collective; empty elsewhere; on one
   // rank the particles themselves, or a copy in id order when sorted).
   Particles<dim> gathered_particles() const;
+  // This rank's id block of the particles (ids [first, first + size) with
+  // first = id_block_begin), in id order (collective; one rank: every
+  // particle, first = 0).
+  Particles<dim> id_block_particles(long long& first) const;
   // Active nodes owned by this rank (the first ones) and the global system
   // id of every active node (distributed; empty on one rank).
   LO owned_nodes() const { return distributed_ ? owned_ : active_; }

@@ -91,8 +91,14 @@ struct SimulationState {
   long step = 0;
   std::vector<double> fem_x, fem_v, fem_a;
   bool has_mpm = false;
+  // The particles' rows, in id order: ids [particle_first, particle_first +
+  // mass.size()) of particle_total (state(): this rank's id block, every
+  // particle on one rank), or, particle_block false (restore() from a
+  // checkpoint written before row blocks), every particle.
   std::vector<double> x, v, mass, volume0, F, C;
   std::vector<long long> body, material;
+  bool particle_block = false;
+  long long particle_first = 0, particle_total = 0;
   // One rank, particles sorted by cell ('MPM/sort particles every'): the id
   // at each array position, so that a restart continues in the same order
   // (empty: id order; never written on several ranks).
@@ -115,6 +121,7 @@ class Simulation {
   // Restart: the state after the last step, and its restoration into a
   // simulation built from the same scene (std::invalid_argument naming the
   // field when the sizes do not match: the scene is not the checkpoint's).
+  // Both are collective on several ranks.
   SimulationState<dim> state() const;
   void restore(const SimulationState<dim>& s);
 

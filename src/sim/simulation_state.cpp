@@ -44,10 +44,12 @@ SimulationState<dim> Simulation<dim>::state() const {
   s.fem_v = to_host(v_);
   s.fem_a = to_host(a_);
   if (mpm_) {
-    // MPI: every rank's particles, in id order, on rank 0 (collective; the
-    // other ranks' state carries no particles).
-    const Particles<dim> p = mpm_->gathered_particles();
+    // MPI: this rank's id block of the particles (collective; nothing passes
+    // through one rank). One rank: every particle, in id order.
+    const Particles<dim> p = mpm_->id_block_particles(s.particle_first);
     s.has_mpm = true;
+    s.particle_block = true;
+    s.particle_total = mpm_->total_particles();
     s.x = to_host(p.x);
     s.v = to_host(p.v);
     s.mass = to_host(p.mass);
@@ -80,10 +82,12 @@ void Simulation<dim>::restore(const SimulationState<dim>& s) {
   from_host(v_, s.fem_v, "fem_v");
   from_host(a_, s.fem_a, "fem_a");
   if (mpm_) {
-    // The checkpoint's whole particle set (MPI: each rank then keeps its box).
+    // The checkpoint's whole particle set, or this rank's id block of it (MPI:
+    // each rank then keeps its box).
     const std::size_t np = s.mass.size();
-    if (static_cast<long long>(np) != mpm_->total_particles())
-      throw std::invalid_argument("restart: checkpoint field 'particle_mass' has " + std::to_string(np) +
+    const long long total = s.particle_block ? s.particle_total : static_cast<long long>(np);
+    if (total != mpm_->total_particles())
+      throw std::invalid_argument("restart: checkpoint field 'particle_mass' has " + std::to_string(total) +
                                   " values, the scene's state has " + std::to_string(mpm_->total_particles()) +
                                   " (is this the checkpoint's scene?)");
     const Particles<dim> p = allocate_particles<dim>(np);
@@ -103,7 +107,10 @@ void Simulation<dim>::restore(const SimulationState<dim>& s) {
     }
     g.dx = s.grid_dx;
     mpm_->restore_grid(g, s.grid_extensions);
-    mpm_->replace_particles(p);  // (MPI: boxes cut on the checkpoint's grid)
+    if (s.particle_block)
+      mpm_->replace_particle_block(p, s.particle_first, total);  // (MPI: boxes cut on the checkpoint's grid)
+    else
+      mpm_->replace_particles(p);
     if (!s.particle_order.empty() && !mpm_->distributed()) mpm_->restore_order(s.particle_order);
   }
   time_ = s.time;

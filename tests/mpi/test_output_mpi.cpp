@@ -8,7 +8,11 @@
 //   writer given the whole data: replicated arrays from rank 0, each rank's
 //   block of rows, static rows, frames kept and dropped on reopening;
 // - bad rows on one rank throw on every rank (no rank is left in a
-//   collective call), and the file stays usable.
+//   collective call), and the file stays usable;
+// - a checkpoint written by R ranks (each its row block of the particle
+//   arrays, rank 0 the replicated ones) reads back, for any reader rank count
+//   and rank, as exactly that reader's rows; a failure on one rank throws on
+//   every rank and leaves the previous checkpoint and no .tmp file.
 #include <gtest/gtest.h>
 
 #include <Teuchos_CommHelpers.hpp>
@@ -19,6 +23,7 @@
 #include <vector>
 
 #include "core/mpi_comm.hpp"
+#include "io/checkpoint.hpp"
 #include "io/hdf5_frames.hpp"
 #include "mpm/particle_distribution.hpp"
 
@@ -260,6 +265,76 @@ TEST(OutputMpi, BadRowsOnOneRankThrowOnEveryRank) {
     EXPECT_FALSE(dataset_exists(path, "/frame_000000/particle_velocities"));
     EXPECT_EQ(read_dataset_int(path, "/frame_000000/particle_body", nullptr), d.ints);
   }
+}
+
+// A checkpoint as every rank puts it: replicated text, attributes and FEM
+// data; this rank's block [lo, hi) of kTotal particle rows (x: 3 columns,
+// body: integers). bad: this rank's x with 0 columns.
+Checkpoint checkpoint_of(int me, int R, double time, bool bad = false) {
+  Checkpoint c;
+  c.time = time;
+  c.step = 7;
+  c.frames = 3;
+  c.dim = 3;
+  c.texts["scene_source"] = "Time: {dt: 0.01}";
+  const Data d = data_of_frame(static_cast<int>(time));
+  c.put("fem_x", d.fem, 2);
+  const long long lo = id_block_begin(kTotal, me, R), hi = id_block_begin(kTotal, me + 1, R);
+  const auto first = static_cast<std::size_t>(lo);
+  c.put_rows("particle_x", std::vector<double>(d.rows.begin() + 3 * lo, d.rows.begin() + 3 * hi), bad ? 0 : 3, first,
+             kTotal);
+  c.put_rows("particle_body", std::vector<long long>(d.ints.begin() + lo, d.ints.begin() + hi), 1, first, kTotal);
+  return c;
+}
+
+// Reader `r` of `n` gets rows [kTotal r / n, kTotal (r + 1) / n) of every
+// blocked array, and every replicated one whole.
+void expect_reads_back(const std::string& path, double time) {
+  const Data d = data_of_frame(static_cast<int>(time));
+  for (int n = 1; n <= 4; ++n)
+    for (int r = 0; r < n; ++r) {
+      const Checkpoint c = read_checkpoint(path, r, n);
+      EXPECT_EQ(c.time, time);
+      EXPECT_EQ(c.step, 7);
+      EXPECT_EQ(c.text("scene_source"), "Time: {dt: 0.01}");
+      EXPECT_EQ(c.real("fem_x", 5), d.fem);
+      EXPECT_FALSE(c.array("fem_x").blocked);
+      const long long lo = kTotal * r / n, hi = kTotal * (r + 1) / n;
+      const CheckpointArray& x = c.array("particle_x");
+      EXPECT_TRUE(x.blocked);
+      EXPECT_EQ(x.first_row, static_cast<std::size_t>(lo)) << r << " of " << n;
+      EXPECT_EQ(x.total_rows, static_cast<std::size_t>(kTotal));
+      EXPECT_EQ(x.cols, 3u);
+      EXPECT_EQ(c.real("particle_x", hi - lo), std::vector<double>(d.rows.begin() + 3 * lo, d.rows.begin() + 3 * hi));
+      EXPECT_EQ(c.ints("particle_body", hi - lo), std::vector<long long>(d.ints.begin() + lo, d.ints.begin() + hi));
+    }
+}
+
+TEST(OutputMpi, CheckpointRowBlocksReadBackByAnyRankCount) {
+  auto world = Tpetra::getDefaultComm();
+  const int me = world->getRank(), R = world->getSize();
+  const std::string path = shared_path("checkpoint.h5");
+  write_checkpoint(path, checkpoint_of(me, R, 1.0), raw_mpi_comm(*world));
+  // Every rank returns once the file is in place: each reads it at once.
+  EXPECT_FALSE(std::filesystem::exists(path + ".tmp"));
+  expect_reads_back(path, 1.0);
+}
+
+TEST(OutputMpi, CheckpointFailureOnOneRankThrowsOnEveryRankAndKeepsTheOldOne) {
+  auto world = Tpetra::getDefaultComm();
+  const int me = world->getRank(), R = world->getSize();
+  const std::string path = shared_path("checkpoint_kept.h5");
+  write_checkpoint(path, checkpoint_of(me, R, 1.0), raw_mpi_comm(*world));
+  // The last rank's particle_x has 0 columns: refused before the collective
+  // create, agreed on, so every rank throws and none waits.
+  EXPECT_THROW(write_checkpoint(path, checkpoint_of(me, R, 2.0, me == R - 1), raw_mpi_comm(*world)),
+               std::runtime_error);
+  world->barrier();
+  EXPECT_FALSE(std::filesystem::exists(path + ".tmp"));
+  expect_reads_back(path, 1.0);
+  // The writer is usable again: the next good checkpoint replaces it.
+  write_checkpoint(path, checkpoint_of(me, R, 2.0), raw_mpi_comm(*world));
+  expect_reads_back(path, 2.0);
 }
 
 }  // namespace

@@ -5,8 +5,9 @@
 # first step (exit 2, a message naming the key); a 2-rank run restarted on 2 ranks equals the
 # uninterrupted one bit for bit. The MPM column (MPM alone: particles in slabs) gives the same
 # frames on 1 and 2 ranks (particles written in scene order: each rank its block, MPI-IO), and its 2-rank restart equals
-# the uninterrupted run to solver tolerance (the restart re-cuts the slabs), as does a 1-rank
-# run restarted on 2 ranks (its serial HDF5 file continued through MPI-IO). The colliding
+# the uninterrupted run to solver tolerance (the restart re-cuts the slabs), as do a 1-rank
+# run restarted on 2 ranks (its serial HDF5 file continued through MPI-IO) and the 2-rank
+# checkpoint (each rank wrote its row block, MPI-IO) restarted on 1 and on 3 ranks. The colliding
 # rings (MPM + FEM, barrier contact) write the same frames on 1 and 2 ranks, the particles'
 # contact forces included (in scene order). The 3D twist (A7, coarsened, shortened)
 # with friction on 2 ranks (CG + BLOCK_CHOLMOD) equals 1 rank (Cholmod): the cube is cut at x = 0 under the
@@ -98,8 +99,14 @@ mcg=(--set 'Linear Solver/type=CG' --set 'Time/end time=0.2')
 "${mpi[@]}" -np 2 "$exe" run "$src/inputs/mpm_column.yaml" --output "$work/mpm2" "${mcg[@]}" > "$work/mpm2.log" 2>&1
 grep -q "MPM particles in slabs" "$work/mpm2.log" || { echo "no MPM slab line in the 2-rank banner"; cat "$work/mpm2.log"; exit 1; }
 "${mpi[@]}" -np 2 "$exe" run "$src/inputs/mpm_column.yaml" --output "$work/mpm2_half" --set 'Linear Solver/type=CG' --set 'Time/end time=0.1' > "$work/mpm2_half.log" 2>&1
+cp -r "$work/mpm2_half" "$work/mpm2_half_on1"; cp -r "$work/mpm2_half" "$work/mpm2_half_on3"
 "${mpi[@]}" -np 2 "$exe" restart "$work/mpm2_half" --set 'Time/end time=0.2' > "$work/mpm2_restart.log" 2>&1 \
   || { echo "MPM restart on 2 ranks failed"; cat "$work/mpm2_restart.log"; exit 1; }
+# The 2-rank checkpoint (row blocks written by each rank) continued on 1 and on 3 ranks.
+for n in 1 3; do
+  "${mpi[@]}" -np $n "$exe" restart "$work/mpm2_half_on$n" --set 'Time/end time=0.2' > "$work/mpm2_restart_on$n.log" 2>&1 \
+    || { echo "the 2-rank MPM checkpoint restarted on $n rank(s) failed"; cat "$work/mpm2_restart_on$n.log"; exit 1; }
+done
 # A 1-rank run (serial HDF5 file) continued on 2 ranks (the file reopened with MPI-IO).
 "${mpi[@]}" -np 1 "$exe" run "$src/inputs/mpm_column.yaml" --output "$work/mpm1_half" --set 'Linear Solver/type=CG' --set 'Time/end time=0.1' > "$work/mpm1_half.log" 2>&1
 # (with the boxes chosen by hand: slabs along x instead of the column's y)
@@ -108,26 +115,30 @@ grep -q "MPM particles in slabs" "$work/mpm2.log" || { echo "no MPM slab line in
   || { echo "a 1-rank MPM run restarted on 2 ranks failed"; cat "$work/mpm1_restart.log"; exit 1; }
 grep -q "MPM particles in slabs along axis 0" "$work/mpm1_restart.log" \
   || { echo "the restart's boxes are not the ones asked for"; cat "$work/mpm1_restart.log"; exit 1; }
-/usr/bin/python3 - "$work/mpm1" "$work/mpm2" "$work/mpm2_half" "$work/mpm1_half" <<'PY'
+/usr/bin/python3 - "$work/mpm1" "$work/mpm2" "$work/mpm2_half" "$work/mpm1_half" "$work/mpm2_half_on1" \
+    "$work/mpm2_half_on3" <<'PY'
 import sys, csv, h5py, numpy as np
-a, b, c, d1 = sys.argv[1:5]
+a, b, c, d1, e1, e3 = sys.argv[1:7]
 with h5py.File(a + "/bfemp.h5", "r") as fa, h5py.File(b + "/bfemp.h5", "r") as fb, h5py.File(c + "/bfemp.h5", "r") as fc, \
-        h5py.File(d1 + "/bfemp.h5", "r") as fd:
+        h5py.File(d1 + "/bfemp.h5", "r") as fd, h5py.File(e1 + "/bfemp.h5", "r") as fe1, \
+        h5py.File(e3 + "/bfemp.h5", "r") as fe3:
+    others = ((fb, "2 ranks"), (fc, "2 ranks restarted"), (fd, "1 rank restarted on 2"),
+              (fe1, "2 ranks restarted on 1"), (fe3, "2 ranks restarted on 3"))
     fr = sorted(k for k in fa if k.startswith("frame_"))
-    for other in (fb, fc, fd):
+    for other, _ in others:
         assert fr == sorted(k for k in other if k.startswith("frame_")), (fr, sorted(other))
     assert len(fr) == 3, fr
     for f in fr:
         for d in fa[f]:
             va = fa[f][d][()]
-            for other, name in ((fb, "2 ranks"), (fc, "2 ranks restarted"), (fd, "1 rank restarted on 2")):
+            for other, name in others:
                 vb = other[f][d][()]
                 assert va.shape == vb.shape, (name, f, d, va.shape, vb.shape)
                 # Newton stops at |p|/dt < 1e-10 m/s (dt 0.02): 2e-12 m per step.
                 tol = 1e-9 if d in ("particle_positions", "particle_body") else 1e-6 * max(np.abs(va).max(), 1e-12)
                 err = np.abs(va - vb).max()
                 assert err <= tol, f"{name}: {f}/{d} differs by {err}"
-for other in (b, c, d1):
+for other in (b, c, d1, e1, e3):
     ra = list(csv.DictReader(open(a + "/diagnostics.csv")))
     rb = list(csv.DictReader(open(other + "/diagnostics.csv")))
     assert len(ra) == len(rb) == 10, (len(ra), len(rb))
@@ -136,7 +147,8 @@ for other in (b, c, d1):
             u, v = float(x[k]), float(y[k])
             assert abs(u - v) <= 1e-7 * max(abs(u), 1e-9), (other, x["step"], k, u, v)
         assert x["active_grid_nodes"] == y["active_grid_nodes"], (other, x["step"])
-print("MPM column: 1 rank, 2 ranks, a 2-rank restart and a 1-rank run restarted on 2 agree (3 frames, 10 diagnostics rows)")
+print("MPM column: 1 rank, 2 ranks, a 2-rank restart, a 1-rank run restarted on 2 and a 2-rank run restarted on 1 and 3 "
+      "agree (3 frames, 10 diagnostics rows)")
 PY
 # MPM and FEM bodies in contact on 2 ranks.
 rcg=(--set 'Linear Solver/type=CG' --set 'Linear Solver/CG/tolerance=1e-13' --set 'Newton/eps_d=1e-9' --set 'Time/end time=0.03')
