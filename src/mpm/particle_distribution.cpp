@@ -66,30 +66,44 @@ void unpack(Kokkos::View<const double**, Kokkos::LayoutRight, MemSpace> buf, std
 }
 
 // Particles grouped by destination rank dest(q): order lists the particles
-// of rank `first` first, then ranks 0, 1, ... (skipping `first`); count[r]
-// per rank.
+// of rank `first` first, then ranks 0, 1, ... (skipping `first`), each group
+// in ascending q (stable, so runs are reproducible); count[r] per rank. A
+// counting sort over chunks of particles: per chunk and rank a count, their
+// running sums (chunks x ranks, on the host), then each chunk places its
+// particles. O(np + chunks x ranks), one pass over the particles whatever
+// the rank count.
 Kokkos::View<LO*, MemSpace> group_by_dest(Kokkos::View<const int*, MemSpace> dest, int nranks, int first,
                                           std::vector<long long>& count) {
   const LO np = static_cast<LO>(dest.extent(0));
   Kokkos::View<LO*, MemSpace> order("mpm_particle_order", np);
   count.assign(nranks, 0);
-  LO offset = 0;
+  constexpr LO kChunk = 4096;
+  const LO chunks = (np + kChunk - 1) / kChunk;
+  if (chunks == 0) return order;
+  Kokkos::View<LO**, Kokkos::LayoutRight, MemSpace> at("mpm_group_counts", chunks, nranks);
+  Kokkos::parallel_for(
+      "mpm_group_count", Kokkos::RangePolicy<ExecSpace>(0, chunks), KOKKOS_LAMBDA(const LO c) {
+        const LO end = (c + 1) * kChunk < np ? (c + 1) * kChunk : np;
+        for (LO q = c * kChunk; q < end; ++q) ++at(c, dest(q));
+      });
+  auto h = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), at);
+  LO offset = 0;  // each chunk's first slot per rank: groups in send order, chunks in order within each
   for (int k = -1; k < nranks; ++k) {
     const int r = k < 0 ? first : k;
     if (k >= 0 && r == first) continue;
-    LO n = 0;
-    const LO base = offset;
-    Kokkos::parallel_scan(
-        "mpm_group_by_owner", Kokkos::RangePolicy<ExecSpace>(0, np),
-        KOKKOS_LAMBDA(const LO q, LO& pos, const bool final) {
-          if (dest(q) != r) return;
-          if (final) order(base + pos) = q;
-          ++pos;
-        },
-        n);
-    count[r] = n;
-    offset += n;
+    for (LO c = 0; c < chunks; ++c) {
+      const LO n = h(c, r);
+      h(c, r) = offset;
+      offset += n;
+      count[r] += n;
+    }
   }
+  Kokkos::deep_copy(at, h);
+  Kokkos::parallel_for(
+      "mpm_group_place", Kokkos::RangePolicy<ExecSpace>(0, chunks), KOKKOS_LAMBDA(const LO c) {
+        const LO end = (c + 1) * kChunk < np ? (c + 1) * kChunk : np;
+        for (LO q = c * kChunk; q < end; ++q) order(at(c, dest(q))++) = q;
+      });
   return order;
 }
 

@@ -12,7 +12,10 @@
 //     rank's box, and a grid node is owned by the rank whose box holds it;
 //     the same with the boxes rebalanced as the particles crowd (every rank
 //     recomputes the jagged cuts from the summed histograms), and a 3D cube
-//     thrown across the cuts of 2 x 2 x 1 boxes.
+//     thrown across the cuts of 2 x 2 x 1 boxes;
+//   - a migration of several chunks (> 4096 particles per rank) keeps each
+//     group in order: the particles that stay first, in their order, then
+//     those of rank 0, 1, ..., each in its sender's order (reproducible runs).
 #include <gtest/gtest.h>
 
 #include <Teuchos_CommHelpers.hpp>
@@ -301,6 +304,48 @@ std::array<long, 2> outside_own_box(const MpmBodies<dim>& mpm, const Comm& world
 }
 
 }  // namespace
+
+TEST(MpmBoxes, MigrationKeepsEachSendersOrderAcrossChunks) {
+  auto comm = Tpetra::getDefaultComm();
+  const int me = comm->getRank(), R = comm->getSize();
+  const long long n = 3 * 4096 + 17;  // four chunks of the counting sort
+  Particles<2> p = allocate_particles<2>(n);
+  Kokkos::View<long long*, MemSpace> ids("ids", n);
+  {
+    auto x = Kokkos::create_mirror_view(p.x);
+    auto ih = Kokkos::create_mirror_view(ids);
+    for (long long k = 0; k < n; ++k) {  // ids me n .. me n + n - 1, scattered over [0, 1)^2
+      const long long id = me * n + k;
+      ih(k) = id;
+      x(k, 0) = std::fmod(0.6180339887 * (id + 1), 1.0);
+      x(k, 1) = std::fmod(0.7548776662 * (id + 1) * (id % 5 + 1), 1.0);
+    }
+    Kokkos::deep_copy(p.x, x);
+    Kokkos::deep_copy(ids, ih);
+  }
+  const GridSpec<2> grid = grid_of<2>({10, 10, 1});
+  long long largest = 0;
+  const RankBoxes<2> boxes = rebalanced_boxes(p, box_layout(grid, R), grid, *comm, largest);
+  const long long moved = migrate_particles(p, ids, boxes, *comm, largest);
+  if (R > 1) EXPECT_GT(moved, R * n / 2);
+  auto ih = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), ids);
+  auto x = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), p.x);
+  const auto h = boxes.mirror();
+  long long mine = static_cast<long long>(ih.extent(0)), all = 0;
+  Teuchos::reduceAll(*comm, Teuchos::REDUCE_SUM, mine, Teuchos::outArg(all));
+  EXPECT_EQ(all, R * n);
+  // Sender rank id / n; the expected order: (sender == me ? -1 : sender, id) ascending.
+  auto key = [&](long long id) { return std::make_pair(id / n == me ? -1LL : id / n, id); };
+  int out_of_order = 0, outside = 0;
+  for (std::size_t q = 0; q < ih.extent(0); ++q) {
+    if (q > 0 && !(key(ih(q - 1)) < key(ih(q)))) ++out_of_order;
+    Vec<2> xq;
+    for (int d = 0; d < 2; ++d) xq(d) = x(q, d);
+    if (h.owner(xq) != me) ++outside;
+  }
+  EXPECT_EQ(out_of_order, 0) << "rank " << me;
+  EXPECT_EQ(outside, 0) << "rank " << me;
+}
 
 TEST(MpmBoxes, DiagonalThrowAcrossBothCutsEqualsOneRank) {
   auto world = Tpetra::getDefaultComm();
