@@ -116,8 +116,8 @@ int main(int argc, char** argv) {
         if (root) log << bfemp::scene_summary(scene);
         bfemp::run_scene(scene, output, comm, log, opt);
       } else {
-        const bfemp::Checkpoint ck = bfemp::read_checkpoint(restart_dir + "/checkpoint.h5", comm->getRank(),
-                                                              comm->getSize());  // (this rank's particle rows)
+        // (each rank its particle rows)
+        const bfemp::Checkpoint ck = bfemp::read_restart_checkpoint(restart_dir + "/checkpoint.h5", *comm);
         const bfemp::Scene scene = bfemp::checkpoint_scene(ck, sets);
         opt.scene_source = ck.text("scene_source");
         opt.overrides = bfemp::checkpoint_overrides(ck, sets);

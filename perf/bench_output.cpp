@@ -212,14 +212,24 @@ bfemp::Particles<3> scattered_particles(long long N, int rank, int P, Kokkos::Vi
   return p;
 }
 
-double write_bfemp(const std::string& path, long long N, int rank, int P, bool gather) {
+// scattered_particles, then, timed from t0 (after a barrier), all of them on
+// rank 0 (gather_particles; the other ranks get none) or each rank's id block
+// (particles_in_id_block).
+bfemp::Particles<3> redistributed(long long N, int rank, int P, bool gather,
+                                  std::chrono::steady_clock::time_point& t0) {
   using namespace bfemp;
   const Teuchos::MpiComm<int> comm(MPI_COMM_WORLD);
   Kokkos::View<long long*, MemSpace> ids;
   const Particles<3> p = scattered_particles(N, rank, P, ids);
   MPI_Barrier(MPI_COMM_WORLD);
-  const auto t0 = std::chrono::steady_clock::now();
-  const Particles<3> b = gather ? gather_particles(p, ids, N, comm) : particles_in_id_block(p, ids, N, comm);
+  t0 = std::chrono::steady_clock::now();
+  return gather ? gather_particles(p, ids, N, comm) : particles_in_id_block(p, ids, N, comm);
+}
+
+double write_bfemp(const std::string& path, long long N, int rank, int P, bool gather) {
+  using namespace bfemp;
+  std::chrono::steady_clock::time_point t0;
+  const Particles<3> b = redistributed(N, rank, P, gather, t0);
   if (gather && rank != 0) {  // rank 0 writes alone
     MPI_Barrier(MPI_COMM_WORLD);
     return seconds_since(t0);
@@ -262,12 +272,8 @@ std::vector<double> host_reals(const V& v) {
 // with the serial writer (bfemp before).
 double write_checkpoint_bench(const std::string& path, long long N, int rank, int P, bool gather) {
   using namespace bfemp;
-  const Teuchos::MpiComm<int> comm(MPI_COMM_WORLD);
-  Kokkos::View<long long*, MemSpace> ids;
-  const Particles<3> p = scattered_particles(N, rank, P, ids);
-  MPI_Barrier(MPI_COMM_WORLD);
-  const auto t0 = std::chrono::steady_clock::now();
-  const Particles<3> b = gather ? gather_particles(p, ids, N, comm) : particles_in_id_block(p, ids, N, comm);
+  std::chrono::steady_clock::time_point t0;
+  const Particles<3> b = redistributed(N, rank, P, gather, t0);
   if (!gather || rank == 0) {
     const auto first = static_cast<std::size_t>(gather ? 0 : id_block_begin(N, rank, P)),
                total = static_cast<std::size_t>(N);

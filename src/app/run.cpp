@@ -6,6 +6,7 @@
 #include <cmath>
 #include <filesystem>
 #include <iomanip>
+#include <iostream>
 #include <map>
 #include <ostream>
 #include <sstream>
@@ -90,7 +91,9 @@ Checkpoint make_checkpoint(const Scene& scene, const RunOptions& opt, const Simu
     c.put_rows("particle_C", st.C, dim * dim, first, total);
     c.put_rows("particle_body", st.body, 1, first, total);
     c.put_rows("particle_material", st.material, 1, first, total);
-    if (!st.particle_order.empty()) c.put("particle_order", st.particle_order);
+    // (one rank only; a row block, so that a restart on R ranks, which does
+    // not use it, reads 1/R of it)
+    if (!st.particle_order.empty()) c.put_rows("particle_order", st.particle_order, 1, 0, st.particle_order.size());
     c.put("grid_origin", std::vector<double>(st.grid_origin.begin(), st.grid_origin.end()));
     c.put("grid_cells", std::vector<long long>(st.grid_cells.begin(), st.grid_cells.end()));
     c.put("grid_dx", std::vector<double>{st.grid_dx});
@@ -128,20 +131,32 @@ SimulationState<dim> checkpoint_state(const Checkpoint& c) {
   st.has_mpm = c.has("particle_x");
   if (st.has_mpm) {
     // This rank's rows (read_checkpoint's block; every row from a checkpoint
-    // written before row blocks), the same block of every field.
+    // written before row blocks), the same block of every field. The fields
+    // are checked by what every rank reads alike (blocked, total rows,
+    // columns, type), so that all ranks refuse a damaged file together
+    // (a refusal on one rank alone would leave the others waiting in the
+    // restore's collectives).
     const CheckpointArray& m = c.array("particle_mass");
     const long rows = static_cast<long>(m.rows);
     st.particle_block = m.blocked;
     st.particle_first = static_cast<long long>(m.first_row);
     st.particle_total = static_cast<long long>(m.total_rows);
-    for (const char* name : {"particle_x", "particle_v", "particle_volume0", "particle_F", "particle_C",
-                             "particle_body", "particle_material"})
-      if (c.array(name).blocked != m.blocked || c.array(name).first_row != m.first_row)
-        throw std::invalid_argument(std::string("restart: checkpoint field '") + name +
-                                    "' is not cut into the same rows as 'particle_mass'");
+    const std::pair<const char*, std::size_t> fields[] = {
+        {"particle_x", dim},          {"particle_v", dim},     {"particle_mass", 1}, {"particle_volume0", 1},
+        {"particle_F", dim * dim},    {"particle_C", dim * dim}, {"particle_body", 1}, {"particle_material", 1}};
+    for (const auto& [name, cols] : fields) {
+      const CheckpointArray& a = c.array(name);
+      const bool integer = std::string(name) == "particle_body" || std::string(name) == "particle_material";
+      if (a.blocked != m.blocked || a.total_rows != m.total_rows || a.cols != cols || a.integer != integer)
+        throw std::invalid_argument(std::string("restart: checkpoint field '") + name + "' has " +
+                                    std::to_string(a.total_rows) + " x " + std::to_string(a.cols) +
+                                    (a.integer ? " integers" : " reals") + ", expected " +
+                                    std::to_string(m.total_rows) + " x " + std::to_string(cols) +
+                                    (integer ? " integers" : " reals") + " (a damaged or foreign checkpoint)");
+    }
     st.x = c.real("particle_x", rows);
     st.v = c.real("particle_v", rows);
-    st.mass = m.real;
+    st.mass = c.real("particle_mass", rows);
     st.volume0 = c.real("particle_volume0", rows);
     st.F = c.real("particle_F", rows);
     st.C = c.real("particle_C", rows);
@@ -397,6 +412,24 @@ void check_restart_override(const std::string& assignment) {
   for (const char* allowed : kRestartKeys) list += std::string(list.empty() ? "" : ", ") + allowed;
   throw std::invalid_argument("restart: --set '" + key + "' would change the checkpointed state or its shape; " +
                               "a restart may change only " + list);
+}
+
+Checkpoint read_restart_checkpoint(const std::string& path, const Comm& comm) {
+  Checkpoint c;
+  std::string error;
+  try {
+    c = read_checkpoint(path, comm.getRank(), comm.getSize());
+  } catch (const std::exception& e) {
+    error = e.what();
+    if (error.empty()) error = "checkpoint '" + path + "' could not be read";
+  }
+  const int ok = error.empty() ? 1 : 0;
+  int all = ok;
+  if (comm.getSize() > 1) Teuchos::reduceAll(comm, Teuchos::REDUCE_MIN, ok, Teuchos::outArg(all));
+  if (all) return c;
+  if (!ok && comm.getRank() != 0) std::cerr << "bfemp: rank " << comm.getRank() << ": " << error << "\n";
+  throw std::invalid_argument(ok ? "checkpoint '" + path + "' could not be read on another rank (its message above)"
+                                 : error);
 }
 
 Scene checkpoint_scene(const Checkpoint& c, const std::vector<std::string>& extra) {

@@ -78,6 +78,12 @@ RunSummary run_scene(const Scene& scene, const std::string& output_dir,
 // naming the key otherwise.
 void check_restart_override(const std::string& assignment);
 
+// `bfemp restart`: read_checkpoint(path, rank, ranks) on every rank of comm
+// (each its particle rows); a failure on any rank throws std::invalid_argument
+// on every rank (the failing rank's message, elsewhere one that points to it;
+// a rank other than 0 prints its own to std::cerr), so no rank goes on alone.
+Checkpoint read_restart_checkpoint(const std::string& path, const Comm& comm);
+
 // The scene a checkpoint was written from, with `extra` overrides applied
 // after its own (each checked by check_restart_override).
 Scene checkpoint_scene(const Checkpoint& c, const std::vector<std::string>& extra);

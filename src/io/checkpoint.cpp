@@ -110,7 +110,10 @@ const std::vector<long long>& Checkpoint::ints(const std::string& name, long row
 namespace {
 
 // Collective over comm (MPI_COMM_NULL: serial). Each object is created by
-// every rank in the same order (std::map order), each failure agreed on.
+// every rank in the same order (std::map order); each step's failure is
+// agreed on, so every rank throws at the same point. (A create that fails on
+// some ranks only would leave the file open on the others; MPI_File_open is
+// collective and fails alike on every rank in practice.)
 void write_unsynced(const std::string& tmp, const Checkpoint& c, MPI_Comm comm, int rank) {
   QuietErrors quiet;
   std::string error;
@@ -123,19 +126,31 @@ void write_unsynced(const std::string& tmp, const Checkpoint& c, MPI_Comm comm, 
   }
   h5::agree(comm, tmp, error, "create");
   Handle f(file, H5Fclose);
-  Handle g(h5::check(H5Gcreate2(f.get(), "/checkpoint", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), tmp,
-                     "cannot create group '/checkpoint'"),
-           H5Gclose);
-  const long long format = Checkpoint::kFormat, step = c.step, frames = c.frames, dim = c.dim;
-  h5::write_scalar_attribute(g.get(), "format", H5T_STD_I64LE, H5T_NATIVE_LLONG, &format, tmp, "/checkpoint");
-  h5::write_scalar_attribute(g.get(), "time", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, &c.time, tmp, "/checkpoint");
-  h5::write_scalar_attribute(g.get(), "step", H5T_STD_I64LE, H5T_NATIVE_LLONG, &step, tmp, "/checkpoint");
-  h5::write_scalar_attribute(g.get(), "frames", H5T_STD_I64LE, H5T_NATIVE_LLONG, &frames, tmp, "/checkpoint");
-  h5::write_scalar_attribute(g.get(), "dim", H5T_STD_I64LE, H5T_NATIVE_LLONG, &dim, tmp, "/checkpoint");
+  hid_t group = -1;
+  try {
+    group = h5::check(H5Gcreate2(f.get(), "/checkpoint", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), tmp,
+                      "cannot create group '/checkpoint'");
+    const long long format = Checkpoint::kFormat, step = c.step, frames = c.frames, dim = c.dim;
+    h5::write_scalar_attribute(group, "format", H5T_STD_I64LE, H5T_NATIVE_LLONG, &format, tmp, "/checkpoint");
+    h5::write_scalar_attribute(group, "time", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, &c.time, tmp, "/checkpoint");
+    h5::write_scalar_attribute(group, "step", H5T_STD_I64LE, H5T_NATIVE_LLONG, &step, tmp, "/checkpoint");
+    h5::write_scalar_attribute(group, "frames", H5T_STD_I64LE, H5T_NATIVE_LLONG, &frames, tmp, "/checkpoint");
+    h5::write_scalar_attribute(group, "dim", H5T_STD_I64LE, H5T_NATIVE_LLONG, &dim, tmp, "/checkpoint");
+  } catch (const std::exception& e) {
+    error = e.what();
+  }
+  Handle g(group, H5Gclose);
+  h5::agree(comm, tmp, error, "the '/checkpoint' group");
   {
-    Handle t(h5::check(H5Gcreate2(g.get(), "text", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), tmp,
-                       "cannot create group '/checkpoint/text'"),
-             H5Gclose);
+    hid_t tg = -1;
+    try {
+      tg = h5::check(H5Gcreate2(g.get(), "text", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), tmp,
+                       "cannot create group '/checkpoint/text'");
+    } catch (const std::exception& e) {
+      error = e.what();
+    }
+    Handle t(tg, H5Gclose);
+    h5::agree(comm, tmp, error, "the '/checkpoint/text' group");
     for (const auto& [name, text] : c.texts)
       h5::write_dataset(t.get(), comm, rank, tmp, "/checkpoint/text", name, H5T_STD_U8LE, H5T_NATIVE_UCHAR,
                         text.data(), text.size(), 0, text.size(), 1, true);
@@ -146,10 +161,15 @@ void write_unsynced(const std::string& tmp, const Checkpoint& c, MPI_Comm comm, 
     h5::write_dataset(g.get(), comm, rank, tmp, "/checkpoint", name, a.integer ? H5T_STD_I64LE : H5T_IEEE_F64LE,
                       a.integer ? H5T_NATIVE_LLONG : H5T_NATIVE_DOUBLE, data, a.rows, a.first_row, a.total_rows,
                       a.cols, !a.blocked);
-    if (a.blocked) {
-      const long long one = 1;
-      h5::write_scalar_attribute(g.get(), "blocked", H5T_STD_I64LE, H5T_NATIVE_LLONG, &one, tmp,
-                                 "/checkpoint/" + name, name.c_str());
+    if (a.blocked) {  // (the same on every rank: write_dataset agreed on the shapes)
+      try {
+        const long long one = 1;
+        h5::write_scalar_attribute(g.get(), "blocked", H5T_STD_I64LE, H5T_NATIVE_LLONG, &one, tmp,
+                                   "/checkpoint/" + name, name.c_str());
+      } catch (const std::exception& e) {
+        error = e.what();
+      }
+      h5::agree(comm, tmp, error, "the attribute 'blocked' of '/checkpoint/" + name + "'");
     }
   }
   h5::check(H5Fflush(f.get(), H5F_SCOPE_GLOBAL), tmp, "flush failed");

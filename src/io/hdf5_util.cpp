@@ -20,27 +20,21 @@ void fail(const std::string& file, const std::string& what) {
 }
 
 hid_t make_fapl(const std::string& file, MPI_Comm comm) {
-  const hid_t fapl = check(H5Pcreate(H5P_FILE_ACCESS), file, "cannot create file access list");
+  // (fail() reads the error stack before the Handle closes the list)
+  Handle fapl(check(H5Pcreate(H5P_FILE_ACCESS), file, "cannot create file access list"), H5Pclose);
 #if H5_VERSION_GE(1, 10, 7)
-  if (H5Pset_file_locking(fapl, 0, 1) < 0) {
-    H5Pclose(fapl);
-    fail(file, "cannot disable file locking");
-  }
+  if (H5Pset_file_locking(fapl.get(), 0, 1) < 0) fail(file, "cannot disable file locking");
 #endif
   if (comm != MPI_COMM_NULL) {
 #ifdef H5_HAVE_PARALLEL
-    if (H5Pset_fapl_mpio(fapl, comm, MPI_INFO_NULL) < 0) {
-      H5Pclose(fapl);
-      fail(file, "cannot select the MPI-IO file driver");
-    }
+    if (H5Pset_fapl_mpio(fapl.get(), comm, MPI_INFO_NULL) < 0) fail(file, "cannot select the MPI-IO file driver");
 #else
-    H5Pclose(fapl);
     throw std::runtime_error("HDF5 file '" + file +
                              "': this HDF5 library has no MPI-IO driver; an MPI run needs parallel HDF5 "
                              "(libhdf5-openmpi-dev)");
 #endif
   }
-  return fapl;
+  return fapl.release();
 }
 
 MPI_Comm parallel_comm(MPI_Comm comm, int& rank) {
@@ -80,6 +74,18 @@ void write_dataset(hid_t loc, MPI_Comm comm, int rank, const std::string& file, 
   const bool parallel = comm != MPI_COMM_NULL;
   const std::string full = loc_name + "/" + name;
   const std::string what = "cannot write dataset '" + full + "'";
+  // The collective create needs one shape on every rank: the extremes over
+  // the ranks (taken by every rank before any check may throw).
+  long long lo[2] = {static_cast<long long>(total_rows), static_cast<long long>(cols)}, hi[2] = {lo[0], lo[1]};
+  if (parallel) {  // one allreduce: the minima of (rows, cols, -rows, -cols)
+    const long long mine[4] = {lo[0], lo[1], -lo[0], -lo[1]};
+    long long least[4];
+    MPI_Allreduce(mine, least, 4, MPI_LONG_LONG, MPI_MIN, comm);
+    lo[0] = least[0];
+    lo[1] = least[1];
+    hi[0] = -least[2];
+    hi[1] = -least[3];
+  }
   std::string bad_args;
   try {
     if (name.empty() || name.find('/') != std::string::npos || name == "." || name == "..")
@@ -93,9 +99,14 @@ void write_dataset(hid_t loc, MPI_Comm comm, int rank, const std::string& file, 
       throw std::invalid_argument("HDF5 file '" + file + "': dataset '" + full + "': rows " +
                                   std::to_string(first_row) + ".." + std::to_string(first_row + rows) + " of " +
                                   std::to_string(total_rows) +
-                                  (parallel && !replicated
-                                       ? ": expected a block inside the dataset"
-                                       : ": expected every row (a serial writer writes whole datasets)"));
+                                  (!parallel ? ": expected every row (a serial writer writes whole datasets)"
+                                   : replicated ? ": expected every row (replicated data)"
+                                                : ": expected a block inside the dataset"));
+    if (lo[0] != hi[0] || lo[1] != hi[1])
+      throw std::invalid_argument("HDF5 file '" + file + "': dataset '" + full + "': the ranks give " +
+                                  std::to_string(lo[0]) + ".." + std::to_string(hi[0]) + " rows and " +
+                                  std::to_string(lo[1]) + ".." + std::to_string(hi[1]) +
+                                  " columns: expected one shape on every rank");
   } catch (const std::invalid_argument& e) {
     if (!parallel) throw;
     bad_args = e.what();

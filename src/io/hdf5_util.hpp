@@ -87,7 +87,9 @@ void agree(MPI_Comm comm, const std::string& file, const std::string& mine, cons
 // Creates dataset loc_name/name of total_rows x cols (1-D when cols == 1) of
 // file_type in `loc` and writes rows [first_row, first_row +
 // rows) from `data` (row-major). replicated: the same data on every rank,
-// rows == total_rows, rank 0 transfers. data: rows x cols of mem_type. Serial: rows == total_rows. Arguments
+// rows == total_rows, rank 0 transfers. data: rows x cols of mem_type.
+// Parallel: one allreduce checks that every rank gives the same total_rows
+// and cols, one more agrees on the result of the write. Serial: rows == total_rows. Arguments
 // are checked and agreed on before the collective create; every failure
 // becomes a runtime_error (invalid_argument for bad arguments, serial) on
 // every rank (see agree).

@@ -178,8 +178,22 @@ void MpmBodies<dim>::replace_particle_block(const Particles<dim>& mine, long lon
     replace_particles(mine);
     return;
   }
+  // The blocks must tile [0, total) in rank order (a checkpoint read whole
+  // on every rank would otherwise put each particle on every rank): one
+  // scan and one reduction, the verdict the same on every rank.
+  const long long np_mine = static_cast<long long>(mine.size());
+  long long upto = 0;
+  Teuchos::scan(*comm_, Teuchos::REDUCE_SUM, np_mine, Teuchos::outArg(upto));
+  const long long wrong_here = upto - np_mine != first || (comm_->getRank() == comm_->getSize() - 1 && upto != total);
+  long long wrong = 0;
+  Teuchos::reduceAll(*comm_, Teuchos::REDUCE_MAX, wrong_here, Teuchos::outArg(wrong));
+  if (wrong)
+    throw std::invalid_argument("restart: the ranks' particle rows do not tile the checkpoint's " +
+                                std::to_string(total) + " particles (rank " + std::to_string(comm_->getRank()) +
+                                ": ids " + std::to_string(first) + ".." + std::to_string(first + np_mine) + ")");
   n_total_ = total;
   setup_.particles = mine;
+  sorted_ = false;
   const std::size_t np = mine.size();
   ids_ = Kokkos::View<long long*, MemSpace>("mpm_particle_ids", np);
   auto ids = ids_;

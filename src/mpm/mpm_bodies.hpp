@@ -131,9 +131,11 @@ class MpmBodies {
   // Restart: the whole particle set of a checkpoint (re-cut when distributed).
   void replace_particles(const Particles<dim>& all);
   // Restart from this rank's id block of a checkpoint (ids first .. first +
-  // mine.size() - 1 of total; collective). Several ranks: boxes cut from the
-  // cell-layer counts summed over the ranks (rebalanced_boxes on the
-  // default layout) and every particle sent to its box, so no rank holds the
+  // mine.size() - 1 of total; collective). Several ranks: the blocks must
+  // tile 0..total-1 in rank order (std::invalid_argument on every rank
+  // otherwise); boxes cut from the cell-layer counts summed over the ranks
+  // (rebalanced_boxes on the scene's layout: 'MPM/boxes per axis' or the
+  // automatic one) and every particle sent to its box, so no rank reads the
   // whole set. One rank: mine is the whole set (std::logic_error otherwise).
   void replace_particle_block(const Particles<dim>& mine, long long first, long long total);
   // Restart on one rank, after replace_particles: the checkpoint's particle

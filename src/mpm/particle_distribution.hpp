@@ -30,9 +30,9 @@
 // Every particle has a global id (its index in the scene's particle list),
 // carried through every migration. Output frames redistribute the particles
 // into contiguous id blocks (particles_in_id_block), one per rank, which the
-// ranks write into one HDF5 file with MPI-IO; checkpoints gather them to
-// rank 0 in id order. Either way a run on R ranks writes the same files as
-// one on 1 rank. One rank: nothing moves, ids are 0..n-1.
+// ranks write into one HDF5 file with MPI-IO; checkpoints too. So a run on R
+// ranks writes the same files as one on 1 rank. One rank: nothing moves, ids
+// are 0..n-1.
 #include <Kokkos_Core.hpp>
 #include <Teuchos_Comm.hpp>
 #include <array>

@@ -13,9 +13,10 @@
 //     the same with the boxes rebalanced as the particles crowd (every rank
 //     recomputes the jagged cuts from the summed histograms), and a 3D cube
 //     thrown across the cuts of 2 x 2 x 1 boxes;
-//   - a migration of several chunks (> 4096 particles per rank) keeps each
-//     group in order: the particles that stay first, in their order, then
-//     those of rank 0, 1, ..., each in its sender's order (reproducible runs).
+//   - a migration of several chunks of the counting sort keeps each group in
+//     order: the particles that stay first, in their order, then those of
+//     rank 0, 1, ..., each in its sender's order (reproducible runs; at the
+//     tests' one thread a placement by atomics would pass too).
 #include <gtest/gtest.h>
 
 #include <Teuchos_CommHelpers.hpp>
@@ -308,7 +309,7 @@ std::array<long, 2> outside_own_box(const MpmBodies<dim>& mpm, const Comm& world
 TEST(MpmBoxes, MigrationKeepsEachSendersOrderAcrossChunks) {
   auto comm = Tpetra::getDefaultComm();
   const int me = comm->getRank(), R = comm->getSize();
-  const long long n = 3 * 4096 + 17;  // four chunks of the counting sort
+  const long long n = 3 * 4096 + 17;  // several chunks of the counting sort (256-4096 particles each)
   Particles<2> p = allocate_particles<2>(n);
   Kokkos::View<long long*, MemSpace> ids("ids", n);
   {
@@ -327,7 +328,7 @@ TEST(MpmBoxes, MigrationKeepsEachSendersOrderAcrossChunks) {
   long long largest = 0;
   const RankBoxes<2> boxes = rebalanced_boxes(p, box_layout(grid, R), grid, *comm, largest);
   const long long moved = migrate_particles(p, ids, boxes, *comm, largest);
-  if (R > 1) EXPECT_GT(moved, R * n / 2);
+  if (R > 1) EXPECT_GT(moved, (R - 1) * n / 2);  // (about (R - 1) n leave: scattered, equal boxes)
   auto ih = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), ids);
   auto x = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), p.x);
   const auto h = boxes.mirror();

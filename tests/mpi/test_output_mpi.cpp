@@ -11,8 +11,9 @@
 //   collective call), and the file stays usable;
 // - a checkpoint written by R ranks (each its row block of the particle
 //   arrays, rank 0 the replicated ones) reads back, for any reader rank count
-//   and rank, as exactly that reader's rows; a failure on one rank throws on
-//   every rank and leaves the previous checkpoint and no .tmp file.
+//   and rank, as exactly that reader's rows (a rank with none included); one
+//   without row blocks (older files) reads whole; a failure on one rank
+//   throws on every rank and leaves the previous checkpoint and no .tmp file.
 #include <gtest/gtest.h>
 
 #include <Teuchos_CommHelpers.hpp>
@@ -284,6 +285,10 @@ Checkpoint checkpoint_of(int me, int R, double time, bool bad = false) {
   c.put_rows("particle_x", std::vector<double>(d.rows.begin() + 3 * lo, d.rows.begin() + 3 * hi), bad ? 0 : 3, first,
              kTotal);
   c.put_rows("particle_body", std::vector<long long>(d.ints.begin() + lo, d.ints.begin() + hi), 1, first, kTotal);
+  // Two rows only: on 3 ranks rank 0 writes none, and readers of 3 or 4 get none.
+  const long long tlo = id_block_begin(2, me, R), thi = id_block_begin(2, me + 1, R);
+  c.put_rows("particle_tiny", std::vector<double>(d.rows.begin() + tlo, d.rows.begin() + thi), 1,
+             static_cast<std::size_t>(tlo), 2);
   return c;
 }
 
@@ -307,6 +312,9 @@ void expect_reads_back(const std::string& path, double time) {
       EXPECT_EQ(x.cols, 3u);
       EXPECT_EQ(c.real("particle_x", hi - lo), std::vector<double>(d.rows.begin() + 3 * lo, d.rows.begin() + 3 * hi));
       EXPECT_EQ(c.ints("particle_body", hi - lo), std::vector<long long>(d.ints.begin() + lo, d.ints.begin() + hi));
+      const long long tlo = 2LL * r / n, thi = 2LL * (r + 1) / n;
+      EXPECT_EQ(c.real("particle_tiny", thi - tlo), std::vector<double>(d.rows.begin() + tlo, d.rows.begin() + thi))
+          << r << " of " << n;
     }
 }
 
@@ -318,6 +326,32 @@ TEST(OutputMpi, CheckpointRowBlocksReadBackByAnyRankCount) {
   // Every rank returns once the file is in place: each reads it at once.
   EXPECT_FALSE(std::filesystem::exists(path + ".tmp"));
   expect_reads_back(path, 1.0);
+}
+
+// A checkpoint without row blocks (as written before 2026-12-07: every array
+// put whole, no "blocked" attribute) reads whole for every reader.
+TEST(OutputMpi, CheckpointWithoutRowBlocksReadsWholeOnEveryRank) {
+  auto world = Tpetra::getDefaultComm();
+  const std::string path = shared_path("checkpoint_whole.h5");
+  if (world->getRank() == 0) {
+    Checkpoint c = checkpoint_of(0, 1, 1.0);
+    for (const char* name : {"particle_x", "particle_body"}) {  // the same arrays, put whole
+      CheckpointArray& a = c.arrays.at(name);
+      a.blocked = false;
+      a.total_rows = a.rows;
+    }
+    write_checkpoint(path, c);
+  }
+  world->barrier();
+  const Data d = data_of_frame(1);
+  for (int n = 1; n <= 3; ++n)
+    for (int r = 0; r < n; ++r) {
+      const Checkpoint c = read_checkpoint(path, r, n);
+      EXPECT_FALSE(c.array("particle_x").blocked);
+      EXPECT_EQ(c.array("particle_x").first_row, 0u);
+      EXPECT_EQ(c.real("particle_x", kTotal), d.rows);
+      EXPECT_EQ(c.ints("particle_body", kTotal), d.ints);
+    }
 }
 
 TEST(OutputMpi, CheckpointFailureOnOneRankThrowsOnEveryRankAndKeepsTheOldOne) {

@@ -7,7 +7,8 @@
 # frames on 1 and 2 ranks (particles written in scene order: each rank its block, MPI-IO), and its 2-rank restart equals
 # the uninterrupted run to solver tolerance (the restart re-cuts the slabs), as do a 1-rank
 # run restarted on 2 ranks (its serial HDF5 file continued through MPI-IO) and the 2-rank
-# checkpoint (each rank wrote its row block, MPI-IO) restarted on 1 and on 3 ranks. The colliding
+# checkpoint (each rank wrote its row block, MPI-IO) restarted on 1 and on 3 ranks, and on 2
+# with its row blocks removed (the older format, read whole). The colliding
 # rings (MPM + FEM, barrier contact) write the same frames on 1 and 2 ranks, the particles'
 # contact forces included (in scene order). The 3D twist (A7, coarsened, shortened)
 # with friction on 2 ranks (CG + BLOCK_CHOLMOD) equals 1 rank (Cholmod): the cube is cut at x = 0 under the
@@ -100,13 +101,27 @@ mcg=(--set 'Linear Solver/type=CG' --set 'Time/end time=0.2')
 grep -q "MPM particles in slabs" "$work/mpm2.log" || { echo "no MPM slab line in the 2-rank banner"; cat "$work/mpm2.log"; exit 1; }
 "${mpi[@]}" -np 2 "$exe" run "$src/inputs/mpm_column.yaml" --output "$work/mpm2_half" --set 'Linear Solver/type=CG' --set 'Time/end time=0.1' > "$work/mpm2_half.log" 2>&1
 cp -r "$work/mpm2_half" "$work/mpm2_half_on1"; cp -r "$work/mpm2_half" "$work/mpm2_half_on3"
+cp -r "$work/mpm2_half" "$work/mpm2_half_old"
+# An older checkpoint (every array whole, no row blocks: the "blocked" attributes removed).
+/usr/bin/python3 - "$work/mpm2_half_old/checkpoint.h5" <<'PY'
+import sys, h5py
+with h5py.File(sys.argv[1], "r+") as f:
+    g = f["checkpoint"]
+    names = [k for k in g if k != "text" and "blocked" in g[k].attrs]
+    assert len(names) == 8, names
+    for k in names:
+        del g[k].attrs["blocked"]
+PY
 "${mpi[@]}" -np 2 "$exe" restart "$work/mpm2_half" --set 'Time/end time=0.2' > "$work/mpm2_restart.log" 2>&1 \
   || { echo "MPM restart on 2 ranks failed"; cat "$work/mpm2_restart.log"; exit 1; }
-# The 2-rank checkpoint (row blocks written by each rank) continued on 1 and on 3 ranks.
+# The 2-rank checkpoint (row blocks written by each rank) continued on 1 and on 3 ranks,
+# and read whole (the older format) on 2.
 for n in 1 3; do
   "${mpi[@]}" -np $n "$exe" restart "$work/mpm2_half_on$n" --set 'Time/end time=0.2' > "$work/mpm2_restart_on$n.log" 2>&1 \
     || { echo "the 2-rank MPM checkpoint restarted on $n rank(s) failed"; cat "$work/mpm2_restart_on$n.log"; exit 1; }
 done
+"${mpi[@]}" -np 2 "$exe" restart "$work/mpm2_half_old" --set 'Time/end time=0.2' > "$work/mpm2_restart_old.log" 2>&1 \
+  || { echo "a checkpoint without row blocks restarted on 2 ranks failed"; cat "$work/mpm2_restart_old.log"; exit 1; }
 # A 1-rank run (serial HDF5 file) continued on 2 ranks (the file reopened with MPI-IO).
 "${mpi[@]}" -np 1 "$exe" run "$src/inputs/mpm_column.yaml" --output "$work/mpm1_half" --set 'Linear Solver/type=CG' --set 'Time/end time=0.1' > "$work/mpm1_half.log" 2>&1
 # (with the boxes chosen by hand: slabs along x instead of the column's y)
@@ -116,14 +131,15 @@ done
 grep -q "MPM particles in slabs along axis 0" "$work/mpm1_restart.log" \
   || { echo "the restart's boxes are not the ones asked for"; cat "$work/mpm1_restart.log"; exit 1; }
 /usr/bin/python3 - "$work/mpm1" "$work/mpm2" "$work/mpm2_half" "$work/mpm1_half" "$work/mpm2_half_on1" \
-    "$work/mpm2_half_on3" <<'PY'
+    "$work/mpm2_half_on3" "$work/mpm2_half_old" <<'PY'
 import sys, csv, h5py, numpy as np
-a, b, c, d1, e1, e3 = sys.argv[1:7]
+a, b, c, d1, e1, e3, o2 = sys.argv[1:8]
 with h5py.File(a + "/bfemp.h5", "r") as fa, h5py.File(b + "/bfemp.h5", "r") as fb, h5py.File(c + "/bfemp.h5", "r") as fc, \
         h5py.File(d1 + "/bfemp.h5", "r") as fd, h5py.File(e1 + "/bfemp.h5", "r") as fe1, \
-        h5py.File(e3 + "/bfemp.h5", "r") as fe3:
+        h5py.File(e3 + "/bfemp.h5", "r") as fe3, h5py.File(o2 + "/bfemp.h5", "r") as fo2:
     others = ((fb, "2 ranks"), (fc, "2 ranks restarted"), (fd, "1 rank restarted on 2"),
-              (fe1, "2 ranks restarted on 1"), (fe3, "2 ranks restarted on 3"))
+              (fe1, "2 ranks restarted on 1"), (fe3, "2 ranks restarted on 3"),
+              (fo2, "2 ranks restarted from a checkpoint without row blocks"))
     fr = sorted(k for k in fa if k.startswith("frame_"))
     for other, _ in others:
         assert fr == sorted(k for k in other if k.startswith("frame_")), (fr, sorted(other))
@@ -138,7 +154,7 @@ with h5py.File(a + "/bfemp.h5", "r") as fa, h5py.File(b + "/bfemp.h5", "r") as f
                 tol = 1e-9 if d in ("particle_positions", "particle_body") else 1e-6 * max(np.abs(va).max(), 1e-12)
                 err = np.abs(va - vb).max()
                 assert err <= tol, f"{name}: {f}/{d} differs by {err}"
-for other in (b, c, d1, e1, e3):
+for other in (b, c, d1, e1, e3, o2):
     ra = list(csv.DictReader(open(a + "/diagnostics.csv")))
     rb = list(csv.DictReader(open(other + "/diagnostics.csv")))
     assert len(ra) == len(rb) == 10, (len(ra), len(rb))
