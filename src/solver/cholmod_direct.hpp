@@ -56,7 +56,7 @@ struct CholmodReuse {
   // With max_iterations > 0: raise the budget to what one factorisation of
   // the analysed graph costs in CG iterations, estimated from the symbolic
   // analysis as
-  //   F / (kBlas3Advantage (4 |L| + 2 |A|))     (at most kMaxByCost),
+  //   F / (kBlas3Advantage (4 |L| + 2 |A|))     (at most kMaxByCost = 40),
   // F CHOLMOD's flop count, |L| the stored factor (L->xsize: two triangular
   // solves), |A| A's stored entries, both triangles (the product with A).
   // kBlas3Advantage: a flop of the supernodal factorisation (dense BLAS 3 on
@@ -68,7 +68,13 @@ struct CholmodReuse {
   // the estimate 3 (the budget stays max_iterations there). Only counts
   // enter, so a run's decisions do not depend on the machine's timing.
   // Supernodal factors only: a simplicial one (CHOLMOD's choice for sparse
-  // factors, flops / nnz(L) < 40) keeps max_iterations.
+  // factors, flops / nnz(L) < 40) keeps max_iterations. The cap: the
+  // estimate prices one solve, but a factor that needs many CG iterations
+  // will need them again at the next Newton iterations, so a new one pays
+  // back sooner than the estimate says. Paper twist at 2 threads, 5 steps
+  // from t = 2.1 (perf/README "A later window"): budget 84 (the estimate)
+  // 50.1 s per step, 20: 44.8, 40: 41.5; from t = 1.0: 84: 15.6 and 16.6
+  // s, 40: 16.0 and 16.7 (within the noise). It was 200.
   bool by_cost = false;
   // LinearSolver: CG on the previous factor may stop at the Newton forcing
   // term (solve()'s `tolerance`), not at `tolerance` ('forcing term').
@@ -79,7 +85,7 @@ struct CholmodReuse {
   // entries outside float's range, is applied in double as before).
   bool single = true;
   static constexpr double kBlas3Advantage = 4.0;
-  static constexpr int kMaxByCost = 200;
+  static constexpr int kMaxByCost = 40;
 };
 
 class CholmodDirect {

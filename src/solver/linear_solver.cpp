@@ -90,8 +90,8 @@ Teuchos::RCP<const Teuchos::ParameterList> linear_solver_schema() {
          rcp(new Teuchos::EnhancedNumberValidator<int>(0, 1000)));
   ch.set("reuse by cost", true,
          "raise the CG budget above 'reuse iterations' to one factorisation's cost in CG iterations, "
-         "estimated from the symbolic analysis (flops / (4 (4 nnz(L) + 2 nnz(A))), at most 200; "
-         "supernodal factors only; measured: 3D twist 25-27 (ci) and 84 (paper size), 2D rings 3)");
+         "estimated from the symbolic analysis (flops / (4 (4 nnz(L) + 2 nnz(A))), at most 40; "
+         "supernodal factors only; measured: 3D twist 25-27 (ci) and 84, capped to 40 (paper size), 2D rings 3)");
   ch.set("reuse tolerance", 1e-10,
          "relative residual |b - A x| / |b| that CG on the previous factor must reach (with "
          "'forcing term: adaptive', the tightest it is asked for)",
