@@ -141,12 +141,17 @@ SimulationState<dim> checkpoint_state(const Checkpoint& c) {
     st.particle_block = m.blocked;
     st.particle_first = static_cast<long long>(m.first_row);
     st.particle_total = static_cast<long long>(m.total_rows);
-    const std::pair<const char*, std::size_t> fields[] = {
-        {"particle_x", dim},          {"particle_v", dim},     {"particle_mass", 1}, {"particle_volume0", 1},
-        {"particle_F", dim * dim},    {"particle_C", dim * dim}, {"particle_body", 1}, {"particle_material", 1}};
-    for (const auto& [name, cols] : fields) {
+    struct Field {
+      const char* name;
+      std::size_t cols;
+      bool integer;
+    };
+    const Field fields[] = {{"particle_x", dim, false},       {"particle_v", dim, false},
+                            {"particle_mass", 1, false},     {"particle_volume0", 1, false},
+                            {"particle_F", dim * dim, false}, {"particle_C", dim * dim, false},
+                            {"particle_body", 1, true},      {"particle_material", 1, true}};
+    for (const auto& [name, cols, integer] : fields) {
       const CheckpointArray& a = c.array(name);
-      const bool integer = std::string(name) == "particle_body" || std::string(name) == "particle_material";
       if (a.blocked != m.blocked || a.total_rows != m.total_rows || a.cols != cols || a.integer != integer)
         throw std::invalid_argument(std::string("restart: checkpoint field '") + name + "' has " +
                                     std::to_string(a.total_rows) + " x " + std::to_string(a.cols) +
