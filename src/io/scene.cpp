@@ -13,6 +13,7 @@
 #include "io/scene_validate.hpp"
 #include "io/scene_yaml.hpp"
 #include "io/shape_mesher.hpp"
+#include "mpm/particle_distribution.hpp"
 #include "mpm/sampling.hpp"
 
 #include "io/scene_messages.hpp"
@@ -184,7 +185,8 @@ Vec<dim> vecd(const Array<double>& a, const std::string& key) {
 }
 
 template <int dim>
-void build_mpm(const Scene& scene, const std::vector<std::string>& mat_names, SimulationSetup<dim>& setup) {
+void build_mpm(const Scene& scene, const std::vector<std::string>& mat_names, ParticleBlock block,
+               SimulationSetup<dim>& setup) {
   const ParameterList& p = scene.params;
   const auto& bodies = p.sublist("MPM Bodies");
   if (bodies.numParams() == 0) return;
@@ -206,13 +208,26 @@ void build_mpm(const Scene& scene, const std::vector<std::string>& mat_names, Si
   } catch (const std::invalid_argument& e) {
     throw std::invalid_argument(std::string("scene sublist 'MPM': ") + e.what());
   }
-  std::vector<Particles<dim>> parts;
-  int body_id = 0;
-  for (auto it = bodies.begin(); it != bodies.end(); ++it, ++body_id) {
-    const std::string name = bodies.name(it);
-    const std::string key = "MPM Bodies/" + name;
-    const auto& b = bodies.sublist(name);
+  // Two passes over the bodies: count each one's particles (every rank the
+  // same), then sample only this rank's id block of their concatenation
+  // (block.count > 1; one block: every particle). Bodies that share a
+  // lattice point overlap (sample_particles' lattice is the same for all).
+  const int ppc = m.get<int>("particles per cell");
+  struct Body {
+    std::string key;
     SamplingShape shape;
+    MeshData mesh;
+    int material = 0;
+    long long count = 0;
+  };
+  std::vector<Body> shapes;
+  shapes.reserve(bodies.numParams());  // (shape.mesh points into the list)
+  for (auto it = bodies.begin(); it != bodies.end(); ++it) {
+    const std::string name = bodies.name(it);
+    Body& body = shapes.emplace_back();
+    body.key = "MPM Bodies/" + name;
+    const auto& b = bodies.sublist(name);
+    SamplingShape& shape = body.shape;
     shape.kind = b.get<std::string>("shape");
     const auto c = b.get<Array<double>>("center");
     shape.center.assign(c.begin(), c.end());
@@ -220,32 +235,62 @@ void build_mpm(const Scene& scene, const std::vector<std::string>& mat_names, Si
     shape.size.assign(sz.begin(), sz.end());
     shape.inner_radius = b.get<double>("inner radius");
     shape.outer_radius = b.get<double>("outer radius");
-    MeshData mesh;
     if (shape.kind == "mesh") {
       std::filesystem::path f(b.get<std::string>("mesh file"));
       if (f.is_relative()) f = std::filesystem::path(scene.base_dir) / f;
       if (!std::filesystem::exists(f))
-        bad(key + "/mesh file", "'" + b.get<std::string>("mesh file") + "'", "an existing closed Gmsh .msh file");
-      mesh = read_gmsh_msh4(f.string(), dim);
-      shape.mesh = &mesh;
+        bad(body.key + "/mesh file", "'" + b.get<std::string>("mesh file") + "'", "an existing closed Gmsh .msh file");
+      body.mesh = read_gmsh_msh4(f.string(), dim);
+      shape.mesh = &body.mesh;
     }
-    const int mat = static_cast<int>(std::find(mat_names.begin(), mat_names.end(), b.get<std::string>("material")) -
-                                     mat_names.begin());
-    Particles<dim> part;
+    body.material = static_cast<int>(
+        std::find(mat_names.begin(), mat_names.end(), b.get<std::string>("material")) - mat_names.begin());
     try {
-      part = sample_particles<dim>(shape, dx, m.get<int>("particles per cell"), setup.materials[mat].density,
-                                   body_id, mat);
+      body.count = count_particles<dim>(shape, dx, ppc);
     } catch (const std::invalid_argument& e) {
-      rethrow_under(key, shape.kind, e);
+      rethrow_under(body.key, shape.kind, e);
     }
-    const auto v0 = vec3(b.get<Array<double>>("initial velocity"), dim, key + "/initial velocity");
-    for (int d = 0; d < dim; ++d) Kokkos::deep_copy(Kokkos::subview(part.v, Kokkos::ALL(), d), v0[d]);
-    parts.push_back(part);
     mpm.body_names.push_back(name);
   }
+  long long total = 0;
+  for (const Body& b : shapes) total += b.count;
+  const long long first = id_block_begin(total, block.rank, block.count),
+                  end = id_block_begin(total, block.rank + 1, block.count);
+  std::vector<Particles<dim>> parts;
+  long long offset = 0;  // the body's first id
+  for (std::size_t i = 0; i < shapes.size(); offset += shapes[i].count, ++i) {
+    const Body& body = shapes[i];
+    const long long lo = std::clamp(first - offset, 0LL, body.count), hi = std::clamp(end - offset, 0LL, body.count);
+    if (lo == hi) continue;
+    Particles<dim> part;
+    try {
+      part = sample_particles<dim>(body.shape, dx, ppc, setup.materials[body.material].density,
+                                   static_cast<int>(i), body.material, lo, hi - lo);
+    } catch (const std::invalid_argument& e) {
+      rethrow_under(body.key, body.shape.kind, e);
+    }
+    const std::string& name = mpm.body_names[i];
+    const auto v0 = vec3(bodies.sublist(name).get<Array<double>>("initial velocity"), dim, body.key + "/initial velocity");
+    for (int d = 0; d < dim; ++d) Kokkos::deep_copy(Kokkos::subview(part.v, Kokkos::ALL(), d), v0[d]);
+    parts.push_back(part);
+  }
   mpm.particles = concatenate(parts);
-  const int ppc = m.get<int>("particles per cell");
-  check_mpm_start(mpm, dx / std::round(std::pow(ppc, 1.0 / dim)));
+  if (block.count > 1) {
+    mpm.particle_first = first;
+    mpm.particle_total = total;
+  }
+  check_mpm_start(mpm);
+  for (std::size_t a = 0; a < shapes.size(); ++a)
+    for (std::size_t b = a + 1; b < shapes.size(); ++b) {
+      double x[dim];
+      if (!first_shared_point<dim>(shapes[a].shape, shapes[b].shape, dx, ppc, x)) continue;
+      std::string at;
+      for (int d = 0; d < dim; ++d) at += (d ? ", " : "") + num(x[d]);
+      throw std::invalid_argument("MPM body '" + mpm.body_names[a] + "' and MPM body '" + mpm.body_names[b] +
+                                  "' overlap: both hold a particle at (" + at +
+                                  ") (their samplings share a sub-cell centre); move their 'center' or change "
+                                  "their sizes so the bodies are apart");
+    }
   setup.mpm = mpm;
   const auto& lss = p.sublist("Level Sets");
   for (auto it = lss.begin(); it != lss.end(); ++it) {
@@ -333,7 +378,10 @@ Scene load_scene_from_string(const std::string& yaml, const std::string& base_di
 }
 
 template <int dim>
-SimulationSetup<dim> build_setup(const Scene& scene) {
+SimulationSetup<dim> build_setup(const Scene& scene, ParticleBlock block) {
+  if (block.count < 1 || block.rank < 0 || block.rank >= block.count)
+    throw std::logic_error("build_setup: particle block " + std::to_string(block.rank) + " of " +
+                           std::to_string(block.count));
   const ParameterList& p = scene.params;
   SimulationSetup<dim> setup;
   std::vector<std::string> mat_names;
@@ -402,7 +450,7 @@ SimulationSetup<dim> build_setup(const Scene& scene) {
     node_offset += static_cast<LO>(in.mesh.num_nodes());
     setup.bodies.push_back(std::move(in));
   }
-  build_mpm<dim>(scene, mat_names, setup);
+  build_mpm<dim>(scene, mat_names, block, setup);
   check_friction_pairs(p);
   const bool fem_fem = p.sublist("Contact").get<bool>("FEM-FEM");
   if (fem_fem && dim == 3) bad("Contact/FEM-FEM", "true", "false in a 3D scene (FEM-FEM contact is 2D only: 3D needs edge-edge pairs)");
@@ -436,8 +484,8 @@ SimulationSetup<dim> build_setup(const Scene& scene) {
   return setup;
 }
 
-template SimulationSetup<2> build_setup<2>(const Scene&);
-template SimulationSetup<3> build_setup<3>(const Scene&);
+template SimulationSetup<2> build_setup<2>(const Scene&, ParticleBlock);
+template SimulationSetup<3> build_setup<3>(const Scene&, ParticleBlock);
 
 std::string scene_summary(const Scene& scene) {
   const auto& p = scene.params;

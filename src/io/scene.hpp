@@ -35,9 +35,23 @@ Scene load_scene(const std::string& path, const std::vector<std::string>& overri
 Scene load_scene_from_string(const std::string& yaml, const std::string& base_dir,
                              const std::vector<std::string>& overrides = {});
 
+// Which particles build_setup samples: with count > 1, only the id block
+// [id_block_begin(N, rank, count), id_block_begin(N, rank + 1, count)) of
+// the N particles of all MPM bodies (MpmSetup::particle_first/_total set;
+// an MPI run passes its rank and size, and no rank holds the whole set);
+// count 1: every particle.
+struct ParticleBlock {
+  int rank = 0;
+  int count = 1;
+};
+
 // Builds meshes (files or Gmsh shapes), materials, motions and solver settings.
+// The start checks on particles (inside the grid, outside level-set solids)
+// see only the block's particles: with count > 1 the callers agree on the
+// verdict (app/run.cpp). Bodies that overlap are refused from their shapes,
+// the same on every rank.
 template <int dim>
-SimulationSetup<dim> build_setup(const Scene& scene);
+SimulationSetup<dim> build_setup(const Scene& scene, ParticleBlock block = {});
 
 // A one-paragraph summary for the start of a run.
 std::string scene_summary(const Scene& scene);

@@ -5,7 +5,6 @@
 #include <cmath>
 #include <sstream>
 #include <stdexcept>
-#include <unordered_map>
 
 #include "io/scene_messages.hpp"
 
@@ -178,7 +177,7 @@ void check_scene_values(const ParameterList& raw) {
 }
 
 template <int dim>
-void check_mpm_start(const MpmSetup<dim>& mpm, double h) {
+void check_mpm_start(const MpmSetup<dim>& mpm) {
   auto x = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), mpm.particles.x);
   auto body = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), mpm.particles.body);
   const std::size_t n = x.extent(0);
@@ -203,40 +202,6 @@ void check_mpm_start(const MpmSetup<dim>& mpm, double h) {
                                   " lies outside the MPM grid domain [(" + lo + "), (" + hi +
                                   ")] (its B-spline stencil needs half a cell inside the grid); enlarge "
                                   "'MPM/domain min'/'MPM/domain max' or set 'MPM/when particles leave: extend'");
-    }
-  }
-  // Overlap: particles hashed by their cell of side h; two of different
-  // bodies within h / 2 of each other (neighbouring cells searched).
-  if (mpm.body_names.size() < 2) return;
-  auto cell = [&](std::size_t q, int d) { return static_cast<long long>(std::floor(x(q, d) / h)); };
-  auto key = [](const long long* c) {
-    unsigned long long k = 1469598103934665603ull;
-    for (int d = 0; d < dim; ++d) k = (k ^ static_cast<unsigned long long>(c[d])) * 1099511628211ull;
-    return k;
-  };
-  std::unordered_multimap<unsigned long long, std::size_t> cells;
-  cells.reserve(n);
-  for (std::size_t q = 0; q < n; ++q) {
-    long long c[dim];
-    for (int d = 0; d < dim; ++d) c[d] = cell(q, d);
-    cells.emplace(key(c), q);
-  }
-  for (std::size_t q = 0; q < n; ++q) {
-    long long c[dim], o[dim];
-    for (int d = 0; d < dim; ++d) c[d] = cell(q, d);
-    for (int m = 0; m < (dim == 2 ? 9 : 27); ++m) {
-      for (int d = 0, r = m; d < dim; ++d, r /= 3) o[d] = c[d] + r % 3 - 1;
-      const auto range = cells.equal_range(key(o));
-      for (auto it = range.first; it != range.second; ++it) {
-        const std::size_t p = it->second;
-        if (body(p) == body(q)) continue;
-        double d2 = 0;
-        for (int d = 0; d < dim; ++d) d2 += (x(p, d) - x(q, d)) * (x(p, d) - x(q, d));
-        if (d2 < 0.25 * h * h)
-          throw std::invalid_argument(name(q) + " and " + name(p) + " overlap: particles at " + where(q) + " and " +
-                                      where(p) + " (closer than half the particle spacing " + num(h) +
-                                      "); move their 'center' or change their sizes so the bodies are apart");
-      }
     }
   }
 }
@@ -265,7 +230,7 @@ void check_level_set_start(const MpmSetup<dim>& mpm, const std::vector<LevelSet>
 
 template void check_level_set_start<2>(const MpmSetup<2>&, const std::vector<LevelSet>&);
 template void check_level_set_start<3>(const MpmSetup<3>&, const std::vector<LevelSet>&);
-template void check_mpm_start<2>(const MpmSetup<2>&, double);
-template void check_mpm_start<3>(const MpmSetup<3>&, double);
+template void check_mpm_start<2>(const MpmSetup<2>&);
+template void check_mpm_start<3>(const MpmSetup<3>&);
 
 }  // namespace bfemp

@@ -27,13 +27,12 @@ void check_friction_pairs(const Teuchos::ParameterList& scene);
 // At most this many steps (end time / dt) are run; more is refused.
 constexpr double kMaxSteps = 1e9;
 
-// The particles of `mpm` (bodies named by mpm.body_names, particle spacing h
-// = dx / ppc^(1/dim)): refuses a particle that is not usable on mpm.grid
-// unless mpm.extend_domain, naming the body, and particles of two bodies
-// closer than h / 2 (overlapping bodies: the sampling lattice is shared, so
-// bodies that overlap have particles in the same places), naming both.
+// The particles of `mpm` (bodies named by mpm.body_names): refuses the
+// first particle that is not usable on mpm.grid unless mpm.extend_domain,
+// naming the body. (Overlapping bodies are refused from their shapes:
+// first_shared_point in mpm/sampling.hpp.)
 template <int dim>
-void check_mpm_start(const MpmSetup<dim>& mpm, double h);
+void check_mpm_start(const MpmSetup<dim>& mpm);
 
 // Refuses a particle that starts inside the solid of a level set (phi < 0 at
 // t = 0), naming the body and the level set: its grid nodes would be

@@ -115,6 +115,14 @@ MpmBodies<dim>::MpmBodies(MpmSetup<dim> setup, Kokkos::View<MaterialParams*, Mem
   resize_stencils();
   n_total_ = static_cast<long long>(np);
   reset_ids();
+  if (setup_.particle_total >= 0) {  // an id block: ids first, first + 1, ...
+    n_total_ = setup_.particle_total;
+    auto ids = ids_;
+    const long long first = setup_.particle_first;
+    Kokkos::parallel_for(
+        "mpm_ids_from", Kokkos::RangePolicy<ExecSpace>(0, np),
+        KOKKOS_LAMBDA(const std::size_t q) { ids(q) += first; });
+  }
   term_ = std::make_unique<MpmElasticityTerm<dim>>("mpm elasticity", stencils_);
 }
 
@@ -152,7 +160,10 @@ void MpmBodies<dim>::distribute(const Teuchos::RCP<const Teuchos::Comm<int>>& co
   global_first_ = global_first;
   distributed_ = comm->getSize() > 1;
   if (!distributed_) return;
-  replace_particles(setup_.particles);
+  if (setup_.particle_total >= 0)
+    replace_particle_block(setup_.particles, setup_.particle_first, setup_.particle_total);
+  else
+    replace_particles(setup_.particles);
 }
 
 template <int dim>
@@ -188,7 +199,7 @@ void MpmBodies<dim>::replace_particle_block(const Particles<dim>& mine, long lon
   long long wrong = 0;
   Teuchos::reduceAll(*comm_, Teuchos::REDUCE_MAX, wrong_here, Teuchos::outArg(wrong));
   if (wrong)
-    throw std::invalid_argument("restart: the ranks' particle rows do not tile the checkpoint's " +
+    throw std::invalid_argument("the ranks' particle rows do not tile the " +
                                 std::to_string(total) + " particles (rank " + std::to_string(comm_->getRank()) +
                                 ": ids " + std::to_string(first) + ".." + std::to_string(first + np_mine) + ")");
   n_total_ = total;

@@ -36,6 +36,14 @@ struct MpmSetup {
   Particles<dim> particles;
   TransferScheme scheme = TransferScheme::APIC;
   std::vector<std::string> body_names;
+  // particle_total < 0: `particles` is every particle (each rank the whole
+  // set; distribute() keeps its box). Otherwise `particles` is this rank's
+  // id block [particle_first, particle_first + size) of particle_total,
+  // in id order, and distribute() moves the blocks into the boxes (the
+  // blocks must tile the ids in rank order; build_setup with a
+  // ParticleBlock).
+  long long particle_first = 0;
+  long long particle_total = -1;
   // A particle whose stencil leaves the grid: false: an error naming the
   // particle and step; true: the grid grows by whole cells before the step
   // (scene key 'MPM/when particles leave: extend').

@@ -196,24 +196,38 @@ double sampling_shape_measure(const SamplingShape& s, int dim) {
   return (s.kind == "ring" ? 1.0 : 0.5) * kPi * (R * R - r * r);
 }
 
+namespace {
+
+// A validated shape on its candidate lattice (sub-cell centres of the cells
+// its bounding box touches), with the inside test of every lattice point.
 template <int dim>
-Particles<dim> sample_particles(const SamplingShape& shape, double dx, int ppc, double density,
-                                int body_id, int material_id) {
+struct ShapeLattice {
+  const SamplingShape* shape = nullptr;
+  Lattice<dim> L;
+  std::vector<char> mark;  // kind "mesh": inside flags by L.linear
+  Vec<dim> c;
+  bool inside(const long long* m) const {
+    return shape->kind == "mesh" ? mark[L.linear(m)] != 0 : inside_function<dim>(*shape, c, L.point(m)) < 0.0;
+  }
+  void last(long long* hi) const {
+    for (int d = 0; d < dim; ++d) hi[d] = L.m_lo[d] + L.count[d] - 1;
+  }
+};
+
+template <int dim>
+ShapeLattice<dim> shape_lattice(const SamplingShape& shape, double dx, int ppc) {
   validate_shape(shape, dim);
   require_positive("dx", dx);
-  require_positive("density", density);
   int s = 0;  // points per axis and cell
   for (int k = 1; k <= (dim == 2 ? 4 : 3); ++k)
     if (static_cast<int>(std::pow(k, dim) + 0.5) == ppc) s = k;
   if (s == 0)
     bad("ppc", std::to_string(ppc), dim == 2 ? "one of 1, 4, 9, 16 in 2D" : "one of 1, 8, 27 in 3D");
-  if (body_id < 0) bad("body_id", std::to_string(body_id), ">= 0");
-  if (material_id < 0) bad("material_id", std::to_string(material_id), ">= 0");
-
   Vec<dim> lo, hi;
   bounding_box<dim>(shape, lo, hi);
-  Lattice<dim> L;
-  L.h = dx / s;
+  ShapeLattice<dim> S;
+  S.shape = &shape;
+  S.L.h = dx / s;
   double candidates = 1.0;
   for (int d = 0; d < dim; ++d) {
     const double c_lo = std::floor(lo[d] / dx), c_hi = std::ceil(hi[d] / dx);
@@ -221,26 +235,60 @@ Particles<dim> sample_particles(const SamplingShape& shape, double dx, int ppc, 
     if (!(candidates <= kMaxCandidates))  // also catches huge coordinates / dx
       bad("dx", fmt(dx), "a larger value (the shape '" + shape.kind + "' would need more than " +
                              fmt(kMaxCandidates) + " candidate points)");
-    L.m_lo[d] = static_cast<long long>(c_lo) * s;
-    L.count[d] = static_cast<long long>(std::max(1.0, c_hi - c_lo)) * s;
+    S.L.m_lo[d] = static_cast<long long>(c_lo) * s;
+    S.L.count[d] = static_cast<long long>(std::max(1.0, c_hi - c_lo)) * s;
   }
+  if (shape.kind == "mesh") S.mark = mesh_marks<dim>(*shape.mesh, S.L);
+  S.c = center_of<dim>(shape);
+  return S;
+}
 
-  std::vector<char> mark;
-  if (shape.kind == "mesh") mark = mesh_marks<dim>(*shape.mesh, L);
-  const Vec<dim> c = center_of<dim>(shape);
-  std::vector<Vec<dim>> kept;
-  long long last[dim];
-  for (int d = 0; d < dim; ++d) last[d] = L.m_lo[d] + L.count[d] - 1;
-  for_each_point<dim>(L.m_lo, last, [&](const long long* m) {
-    const Vec<dim> x = L.point(m);
-    if (shape.kind == "mesh" ? mark[L.linear(m)] != 0 : inside_function<dim>(shape, c, x) < 0.0)
-      kept.push_back(x);
+// Calls keep(k, x) for the inside points k = 0, 1, ... (x fastest) and
+// returns their number; throws for a shape that holds none.
+template <int dim, class Fn>
+long long scan_inside(const ShapeLattice<dim>& S, double dx, int ppc, Fn&& keep) {
+  long long k = 0, last[dim];
+  S.last(last);
+  for_each_point<dim>(S.L.m_lo, last, [&](const long long* m) {
+    if (S.inside(m)) keep(k++, S.L.point(m));
   });
-  if (kept.empty())
-    throw std::invalid_argument("shape '" + shape.kind + "' with dx " + fmt(dx) +
+  if (k == 0)
+    throw std::invalid_argument("shape '" + S.shape->kind + "' with dx " + fmt(dx) +
                                 " produced no particles (ppc " + std::to_string(ppc) +
                                 "): expected the shape to contain at least one sub-cell centre; "
                                 "use a smaller dx or a larger ppc");
+  return k;
+}
+
+}  // namespace
+
+template <int dim>
+long long count_particles(const SamplingShape& shape, double dx, int ppc) {
+  return scan_inside(shape_lattice<dim>(shape, dx, ppc), dx, ppc, [](long long, const Vec<dim>&) {});
+}
+
+template <int dim>
+Particles<dim> sample_particles(const SamplingShape& shape, double dx, int ppc, double density,
+                                int body_id, int material_id) {
+  return sample_particles<dim>(shape, dx, ppc, density, body_id, material_id, 0, -1);
+}
+
+template <int dim>
+Particles<dim> sample_particles(const SamplingShape& shape, double dx, int ppc, double density, int body_id,
+                                int material_id, long long first, long long count) {
+  const ShapeLattice<dim> S = shape_lattice<dim>(shape, dx, ppc);
+  require_positive("density", density);
+  if (body_id < 0) bad("body_id", std::to_string(body_id), ">= 0");
+  if (material_id < 0) bad("material_id", std::to_string(material_id), ">= 0");
+  if (first < 0) bad("first", std::to_string(first), ">= 0");
+  const long long end = count < 0 ? std::numeric_limits<long long>::max() : first + count;
+  std::vector<Vec<dim>> kept;
+  const long long total = scan_inside(S, dx, ppc, [&](long long k, const Vec<dim>& x) {
+    if (k >= first && k < end) kept.push_back(x);
+  });
+  if (count >= 0 && end > total)
+    bad("first", std::to_string(first), "a range of " + std::to_string(count) + " particles inside the shape's " +
+                                             std::to_string(total));
 
   Particles<dim> p = allocate_particles<dim>(kept.size());
   auto x = Kokkos::create_mirror_view(p.x);
@@ -262,6 +310,30 @@ Particles<dim> sample_particles(const SamplingShape& shape, double dx, int ppc, 
   Kokkos::deep_copy(p.body, body);
   Kokkos::deep_copy(p.material, mat);
   return p;
+}
+
+template <int dim>
+bool first_shared_point(const SamplingShape& a, const SamplingShape& b, double dx, int ppc, double* x) {
+  const ShapeLattice<dim> A = shape_lattice<dim>(a, dx, ppc), B = shape_lattice<dim>(b, dx, ppc);
+  long long lo[dim], hi[dim], ha[dim], hb[dim];
+  A.last(ha);
+  B.last(hb);
+  for (int d = 0; d < dim; ++d) {
+    lo[d] = std::max(A.L.m_lo[d], B.L.m_lo[d]);
+    hi[d] = std::min(ha[d], hb[d]);
+  }
+  bool found = false;
+  long long at[dim];
+  for_each_point<dim>(lo, hi, [&](const long long* m) {
+    if (found || !A.inside(m) || !B.inside(m)) return;
+    found = true;
+    std::copy(m, m + dim, at);
+  });
+  if (found) {
+    const Vec<dim> p = A.L.point(at);
+    for (int d = 0; d < dim; ++d) x[d] = p[d];
+  }
+  return found;
 }
 
 template <int dim>
@@ -290,6 +362,12 @@ std::string sampling_report(const SamplingShape& shape, const Particles<dim>& pa
 
 template Particles<2> sample_particles<2>(const SamplingShape&, double, int, double, int, int);
 template Particles<3> sample_particles<3>(const SamplingShape&, double, int, double, int, int);
+template Particles<2> sample_particles<2>(const SamplingShape&, double, int, double, int, int, long long, long long);
+template Particles<3> sample_particles<3>(const SamplingShape&, double, int, double, int, int, long long, long long);
+template long long count_particles<2>(const SamplingShape&, double, int);
+template long long count_particles<3>(const SamplingShape&, double, int);
+template bool first_shared_point<2>(const SamplingShape&, const SamplingShape&, double, int, double*);
+template bool first_shared_point<3>(const SamplingShape&, const SamplingShape&, double, int, double*);
 template std::string sampling_report<2>(const SamplingShape&, const Particles<2>&, double, int);
 template std::string sampling_report<3>(const SamplingShape&, const Particles<3>&, double, int);
 

@@ -48,6 +48,29 @@ template <int dim>
 Particles<dim> sample_particles(const SamplingShape& shape, double dx, int ppc, double density,
                                 int body_id, int material_id);
 
+// Rows [first, first + count) of sample_particles' result, in its order
+// (count < 0: to the end), without holding the others: the shape's lattice
+// is scanned whole and only the range is kept, so that each MPI rank can
+// sample its own id block of a body. Throws as sample_particles does, and
+// for a range that does not lie inside [0, count_particles).
+template <int dim>
+Particles<dim> sample_particles(const SamplingShape& shape, double dx, int ppc, double density, int body_id,
+                                int material_id, long long first, long long count);
+
+// The number of particles sample_particles keeps (the same checks of shape,
+// dx and ppc, the empty result included); nothing is allocated but the
+// inside flags of a mesh shape.
+template <int dim>
+long long count_particles(const SamplingShape& shape, double dx, int ppc);
+
+// Whether two shapes sampled with the same dx and ppc hold a particle at the
+// same place (every body is sampled on one lattice, whose points are h = dx /
+// ppc^(1/dim) apart, so particles of two bodies are either at one point or at
+// least h apart). On true, x (dim entries) is the first shared point, x
+// fastest. Scans only the intersection of the two shapes' lattices.
+template <int dim>
+bool first_shared_point(const SamplingShape& a, const SamplingShape& b, double dx, int ppc, double* x);
+
 // Exact area (2D) or volume (3D) of the shape: analytic for box, disk,
 // sphere, ring and half-ring, total_measure(*mesh) for mesh, NaN for sdf.
 // Expects a shape that sample_particles accepts.

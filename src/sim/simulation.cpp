@@ -78,7 +78,7 @@ Simulation<dim>::Simulation(SimulationSetup<dim> setup, const Teuchos::RCP<const
     Kokkos::parallel_reduce(
         "mpm_min_particle_mass", Kokkos::RangePolicy<ExecSpace>(0, pm.extent(0)),
         KOKKOS_LAMBDA(const std::size_t q, double& acc) { acc = pm(q) < acc ? pm(q) : acc; }, Kokkos::Min<double>(m));
-    mpm_min_particle_mass_ = std::isfinite(m) ? m : 0.0;
+    mpm_min_particle_mass_ = m;  // (+inf without particles here; made finite below)
   }
   comm_ = comm;
   if (comm->getSize() > 1 && setup_.mpm) {
@@ -111,6 +111,7 @@ Simulation<dim>::Simulation(SimulationSetup<dim> setup, const Teuchos::RCP<const
     double m = mpm_min_particle_mass_;
     Teuchos::reduceAll(*comm, Teuchos::REDUCE_MIN, m, Teuchos::outArg(mpm_min_particle_mass_));
   }
+  if (!std::isfinite(mpm_min_particle_mass_)) mpm_min_particle_mass_ = 0.0;
   newton_ = std::make_unique<NewtonSolver<dim>>(comm, setup_.linear_solver, setup_.newton);
   sys_ = std::make_unique<System>();
   if (comm->getSize() > 1 && !setup_.mpm) {

@@ -13,7 +13,9 @@
 //     the colliding rings (frictionless, 40 steps through the first contact)
 //     and the disk thrown on an MPM floor with friction mu 0.5 (the lagged
 //     friction loop, 10 steps): particles, FEM nodes, energies, contact pairs
-//     and the contact force on every step.
+//     and the contact force on every step. These scenes are sampled by id
+//     blocks, each rank its own (build_setup with a ParticleBlock), and the
+//     blocks then move into the boxes.
 // On one rank (np1) the same tests compare the scene with itself through the
 // same code path (distribute() is a no-op), which keeps them meaningful there.
 #include <gtest/gtest.h>
@@ -153,7 +155,9 @@ SceneResult run_scene_steps(const std::string& file, const std::vector<std::stri
   o.push_back("Linear Solver/type=CG");
   o.push_back("Linear Solver/CG/tolerance=1e-13");
   const Scene scene = load_scene(std::string(BFEMP_SOURCE_DIR) + "/inputs/" + file, o);
-  Simulation<2> sim(build_setup<2>(scene), comm);
+  // Each rank samples its id block of the particles, as `bfemp run` does
+  // (alone: every particle).
+  Simulation<2> sim(build_setup<2>(scene, ParticleBlock{comm->getRank(), comm->getSize()}), comm);
   SceneResult out;
   out.r.momentum0 = sim.diagnostics().momentum;
   for (int s = 0; s < steps; ++s) {

@@ -2,7 +2,8 @@
 # The bfemp executable on 1 and 2 MPI ranks (label mpi): the squash scene
 # (FEM only, CG) gives the same frames and diagnostics on both; on 2 ranks a
 # direct solver, FEM-FEM contact and an explicit scene are refused before the
-# first step (exit 2, a message naming the key); a 2-rank run restarted on 2 ranks equals the
+# first step (exit 2, a message naming the key), as are particles starting outside the grid or
+# inside a level set's solid, found in one rank's sampled block or in both (the message 1 rank gives); a 2-rank run restarted on 2 ranks equals the
 # uninterrupted one bit for bit. The MPM column (MPM alone: particles in slabs) gives the same
 # frames on 1 and 2 ranks (particles written in scene order: each rank its block, MPI-IO), and its 2-rank restart equals
 # the uninterrupted run to solver tolerance (the restart re-cuts the slabs), as do a 1-rank
@@ -94,6 +95,23 @@ set -e
   || { echo "boxes for 1 rank on 2 ranks: exit $rc"; cat "$work/boxes.log"; exit 1; }
 [ ! -e "$work/boxes/bfemp.h5" ] || { echo "the refused boxes run wrote output"; exit 1; }
 echo "refusals on 2 ranks: direct solver, FEM-FEM contact, explicit scene, boxes for another rank count (exit 2)"
+# Each rank samples its id block of the particles and checks only those: a
+# bad start found on one rank (the column's top, rank 1's block, above the
+# grid) or on both (the ground raised into the column) stops both ranks with
+# exit 2 and the message 1 rank gives (the first particle in id order).
+for bad in "MPM/domain max=[0.5, 0.8]" "Level Sets/ground/point=[0.0, 0.6]"; do
+  for np in 1 2; do
+    set +e
+    "${mpi[@]}" -np $np "$exe" run "$src/inputs/mpm_column.yaml" --output "$work/bad_start$np" \
+      --set 'Linear Solver/type=CG' --set "$bad" > "$work/bad_start$np.log" 2>&1; rc=$?
+    set -e
+    [ $rc = 2 ] || { echo "bad start ($bad) on $np rank(s): exit $rc"; cat "$work/bad_start$np.log"; exit 1; }
+    [ ! -e "$work/bad_start$np/bfemp.h5" ] || { echo "the refused run ($bad) wrote output"; exit 1; }
+  done
+  m1=$(grep "bad input" "$work/bad_start1.log"); m2=$(grep "bad input" "$work/bad_start2.log")
+  [ -n "$m1" ] && [ "$m1" = "$m2" ] || { echo "bad start ($bad): 1 rank '$m1', 2 ranks '$m2'"; cat "$work/bad_start2.log"; exit 1; }
+done
+echo "bad starts found by one rank's particle block or by both: exit 2 on 2 ranks, the 1-rank message"
 # MPM bodies alone on 2 ranks.
 mcg=(--set 'Linear Solver/type=CG' --set 'Time/end time=0.2')
 "${mpi[@]}" -np 1 "$exe" run "$src/inputs/mpm_column.yaml" --output "$work/mpm1" "${mcg[@]}" > "$work/mpm1.log" 2>&1

@@ -247,3 +247,98 @@ TEST(Sampling, BadInputIsRejectedWithTheFieldNamed) {
 }
 
 }  // namespace
+
+// Ranges of the sampling (each MPI rank samples its id block of a body):
+// count_particles is the whole sampling's size, and the ranges of any split
+// [n k / K, n (k+1) / K), empty ones included, concatenate to the whole
+// sampling bit for bit, fields included; a range past the end is refused.
+template <int dim>
+void expect_ranges_tile(const SamplingShape& s, double dx, int ppc) {
+  const Particles<dim> whole = sample_particles<dim>(s, dx, ppc, 2.5, 3, 1);
+  const long long n = count_particles<dim>(s, dx, ppc);
+  ASSERT_EQ(n, static_cast<long long>(whole.size())) << s.kind;
+  auto xw = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), whole.x);
+  for (long long K : {1LL, 2LL, 3LL, 7LL, n + 2}) {
+    long long row = 0;
+    for (long long k = 0; k < K; ++k) {
+      const long long lo = n * k / K, hi = n * (k + 1) / K;
+      const Particles<dim> part = sample_particles<dim>(s, dx, ppc, 2.5, 3, 1, lo, hi - lo);
+      ASSERT_EQ(static_cast<long long>(part.size()), hi - lo) << s.kind << " K " << K << " k " << k;
+      auto x = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), part.x);
+      auto m = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), part.mass);
+      auto b = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), part.body);
+      auto mat = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), part.material);
+      for (std::size_t q = 0; q < part.size(); ++q, ++row) {
+        for (int d = 0; d < dim; ++d) ASSERT_EQ(x(q, d), xw(row, d)) << s.kind << " K " << K << " row " << row;
+        ASSERT_EQ(m(q), 2.5 * std::pow(dx, dim) / ppc);
+        ASSERT_EQ(b(q), 3);
+        ASSERT_EQ(mat(q), 1);
+      }
+    }
+    EXPECT_EQ(row, n) << s.kind << " K " << K;
+  }
+  EXPECT_EQ(sample_particles<dim>(s, dx, ppc, 2.5, 3, 1, n, 0).size(), 0u);
+  EXPECT_THROW(sample_particles<dim>(s, dx, ppc, 2.5, 3, 1, n - 1, 2), std::invalid_argument) << s.kind;
+  EXPECT_THROW(sample_particles<dim>(s, dx, ppc, 2.5, 3, 1, -1, 1), std::invalid_argument) << s.kind;
+}
+
+TEST(Sampling, RangesTileTheWholeSampling) {
+  expect_ranges_tile<2>(shape("ring", {0.1, -0.2}, {}, 0.3, 0.5), 0.05, 4);
+  expect_ranges_tile<2>(shape("half-ring", {0.0, 0.0}, {}, 0.2, 0.4), 0.05, 9);
+  expect_ranges_tile<3>(shape("box", {0.5, 0.5, 0.5}, {0.3, 0.2, 0.4}), 0.1, 8);
+  ShapeSpec disk;
+  disk.kind = "disk";
+  disk.center = {0.05, -0.1};
+  disk.outer_radius = 0.3;
+  disk.element_size = 0.05;
+  const MeshData mesh = mesh_shape(disk, 2);
+  SamplingShape m;
+  m.kind = "mesh";
+  m.mesh = &mesh;
+  expect_ranges_tile<2>(m, 0.05, 4);
+  // The empty sampling is refused by the count as by the sampling.
+  EXPECT_THROW(count_particles<2>(shape("disk", {0.0, 0.0}, {}, 0.0, 1e-4), 0.05, 4), std::invalid_argument);
+}
+
+// Overlap of two bodies from their shapes: first_shared_point agrees with
+// the particles themselves (a pair of the two samplings closer than h / 2,
+// h the lattice spacing, brute force), and the point it returns is the
+// first such particle of the first shape, x fastest.
+template <int dim>
+void expect_shared_point(const SamplingShape& a, const SamplingShape& b, double dx, int ppc, bool expected) {
+  const Particles<dim> pa = sample_particles<dim>(a, dx, ppc, 1.0, 0, 0);
+  const Particles<dim> pb = sample_particles<dim>(b, dx, ppc, 1.0, 1, 0);
+  auto xa = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), pa.x);
+  auto xb = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), pb.x);
+  const double h = dx / std::round(std::pow(ppc, 1.0 / dim));
+  long long first = -1;
+  for (std::size_t p = 0; p < pa.size() && first < 0; ++p)
+    for (std::size_t q = 0; q < pb.size(); ++q) {
+      double r2 = 0;
+      for (int d = 0; d < dim; ++d) r2 += (xa(p, d) - xb(q, d)) * (xa(p, d) - xb(q, d));
+      if (r2 < 0.25 * h * h) {
+        first = static_cast<long long>(p);
+        break;
+      }
+    }
+  double x[dim];
+  const bool found = first_shared_point<dim>(a, b, dx, ppc, x);
+  EXPECT_EQ(found, first >= 0) << a.kind << " / " << b.kind;
+  EXPECT_EQ(found, expected) << a.kind << " / " << b.kind;
+  if (found && first >= 0)
+    for (int d = 0; d < dim; ++d) EXPECT_EQ(x[d], xa(first, d)) << a.kind << " / " << b.kind << " axis " << d;
+}
+
+TEST(Sampling, SharedPointMatchesTheSamplings) {
+  const auto ring = shape("ring", {0.0, 0.0}, {}, 0.3, 0.5);
+  expect_shared_point<2>(ring, shape("disk", {0.0, 0.0}, {}, 0.0, 0.25), 0.05, 4, false);  // in the hole
+  expect_shared_point<2>(ring, shape("disk", {0.1, 0.0}, {}, 0.0, 0.25), 0.05, 4, true);   // on the ring
+  expect_shared_point<2>(shape("disk", {0.5, 0.1}, {}, 0.0, 0.25), ring, 0.05, 9, true);
+  // Boxes sharing an edge are apart; overlapping by one sub-cell they are not.
+  expect_shared_point<2>(shape("box", {0.3, 0.5}, {0.2, 0.2}), shape("box", {0.5, 0.5}, {0.2, 0.2}), 0.1, 4, false);
+  expect_shared_point<2>(shape("box", {0.3, 0.5}, {0.2, 0.2}), shape("box", {0.47, 0.5}, {0.2, 0.2}), 0.1, 4, true);
+  expect_shared_point<3>(shape("box", {0.0, 0.0, 0.0}, {0.4, 0.4, 0.4}), shape("sphere", {0.35, 0.0, 0.0}, {}, 0.0, 0.2),
+                         0.1, 8, true);
+  expect_shared_point<3>(shape("box", {0.0, 0.0, 0.0}, {0.4, 0.4, 0.4}), shape("sphere", {0.45, 0.0, 0.0}, {}, 0.0, 0.2),
+                         0.1, 8, false);
+}

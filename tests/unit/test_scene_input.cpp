@@ -221,6 +221,54 @@ TEST(SceneInput, OverlappingBodiesAreRefusedNamingBoth) {
   EXPECT_EQ(error_of(replaced(kScene, "center: [0.7, 0.5]", "center: [0.5, 0.5]")), "");
 }
 
+// Each MPI rank samples its id block of the scene's particles
+// (build_setup with a ParticleBlock): for any block count, 0-particle blocks
+// included, the blocks in rank order are the whole sampling bit for bit
+// (positions, initial velocities, masses, bodies, materials), the block
+// starts are id_block_begin and the total is the whole count.
+TEST(SceneInput, ParticleBlocksTileTheScenesParticlesInIdOrder) {
+  const Scene scene = load(kScene, {"MPM Bodies/right/initial velocity=[1.5, -2.0]",
+                                    "MPM Bodies/right/material=hard"});
+  const SimulationSetup<2> whole = build_setup<2>(scene);
+  const Particles<2>& w = whole.mpm->particles;
+  const long long n = static_cast<long long>(w.size());
+  ASSERT_EQ(n, 32);  // two 0.2 x 0.2 boxes, dx 0.1, 4 per cell
+  EXPECT_EQ(whole.mpm->particle_total, -1);
+  auto wx = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), w.x);
+  auto wv = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), w.v);
+  auto wm = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), w.mass);
+  auto wb = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), w.body);
+  auto wmat = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), w.material);
+  ASSERT_NE(wmat(0), wmat(n - 1));
+  for (int R : {2, 3, 5, 16, 40}) {
+    long long row = 0;
+    for (int r = 0; r < R; ++r) {
+      const SimulationSetup<2> part = build_setup<2>(scene, ParticleBlock{r, R});
+      const Particles<2>& p = part.mpm->particles;
+      EXPECT_EQ(part.mpm->particle_total, n);
+      EXPECT_EQ(part.mpm->particle_first, n * r / R) << "R " << R << " r " << r;
+      ASSERT_EQ(static_cast<long long>(p.size()), n * (r + 1) / R - n * r / R) << "R " << R << " r " << r;
+      EXPECT_EQ(part.mpm->body_names, whole.mpm->body_names);
+      auto x = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), p.x);
+      auto v = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), p.v);
+      auto m = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), p.mass);
+      auto b = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), p.body);
+      auto mat = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), p.material);
+      for (std::size_t q = 0; q < p.size(); ++q, ++row) {
+        for (int d = 0; d < 2; ++d) {
+          ASSERT_EQ(x(q, d), wx(row, d)) << "R " << R << " row " << row;
+          ASSERT_EQ(v(q, d), wv(row, d)) << "R " << R << " row " << row;
+        }
+        ASSERT_EQ(m(q), wm(row));
+        ASSERT_EQ(b(q), wb(row));
+        ASSERT_EQ(mat(q), wmat(row));
+      }
+    }
+    EXPECT_EQ(row, n) << "R " << R;
+  }
+  EXPECT_THROW(build_setup<2>(scene, ParticleBlock{2, 2}), std::logic_error);
+}
+
 TEST(SceneInput, EmptyMaterialAndNewmarkAndStepCount) {
   expect_message(error_of(replaced(kScene, "    hard:\n      E: 1.0e7\n      density: 1000.0\n",
                                    "    hard: {}\n    other:\n      E: 1.0e7\n")),
