@@ -8,7 +8,9 @@
 # 1-rank checkpoint is cut into the 2 ranks' slabs at the restart). Writes
 # the mean per step of step_s, assembly_s, solve_s, the Newton and linear
 # iterations and friction passes, and from the summary the graph builds,
-# symbolic and numeric factorisations and MPI exchanges per step, with the
+# symbolic and numeric factorisations and MPI exchanges per step, the time
+# of a Newton iteration split into assembly, DOF export/import, solve,
+# contact, line search, particle migration and output (per_newton_*), with the
 # peak resident memory (the largest rank's), as JSON that perf/compare.py reads
 # (each run's log and diagnostics.csv are kept beside it, in FILE without .json + _logs/):
 #   perf/run_twist_paper.sh [--build-dir DIR] [--out FILE] [--checkpoint DIR] [--steps N]
@@ -117,13 +119,30 @@ for spec in runs:
                    r"([0-9.eE+-]+) s particle migration", text)
     exchange, exchange_mb, migration = (float(ex.group(i)) for i in (1, 2, 3)) if ex else (0.0, 0.0, 0.0)
     steps_total = sum(float(r["step_s"]) for r in rows)
+    # The MPI issue's split of a Newton iteration (the restart's summary
+    # covers only the timed steps): assembly, DOF export/import, linear
+    # solve, contact (broad phase, pair evaluation, CCD: within assembly and
+    # the line search), particle migration and output, each over the run's
+    # Newton iterations; per_newton_s = step_s / newton_iters.
+    its = total(r"Newton iterations\s+(\d+)")
+    cont = re.search(r"contact: broad phase ([0-9.eE+-]+) s, pair evaluation ([0-9.eE+-]+) s, CCD ([0-9.eE+-]+) s", text)
+    contact = sum(float(cont.group(i)) for i in (1, 2, 3)) if cont else 0.0
+    per_it = lambda v: v / its if its > 0 else float("nan")
+    split = {"per_newton_s": per_it(steps_total),
+             "per_newton_assembly_s": per_it(total(r"assembly time\s+([0-9.eE+-]+) s")),
+             "per_newton_export_s": per_it(exchange),
+             "per_newton_solve_s": per_it(total(r"linear-solve time\s+([0-9.eE+-]+) s")),
+             "per_newton_contact_s": per_it(contact),
+             "per_newton_line_search_s": per_it(total(r"line-search time\s+([0-9.eE+-]+) s")),
+             "per_newton_migration_s": per_it(migration),
+             "per_newton_output_s": per_it(total(r"output time\s+([0-9.eE+-]+) s"))}
     results.append({"dim": 3, "size": "twist_paper" if abs(t0 - 1.0) < 1e-9 else f"twist_paper_t{t0:g}", "solver": name, "threads": int(np_) * int(nt),
                     "ranks": int(np_), "threads_per_rank": int(nt), "twisting_steps": n, **m,
                     "graph_builds_per_step": total(r"graph builds\s+(\d+)") / max(n, 1),
                     "symbolic_factorisations_per_step": total(r"symbolic factorisations (\d+)") / max(n, 1),
                     "numeric_factorisations_per_step": total(r"factorisations\s+(\d+) numeric") / max(n, 1),
                     "comm_share": (exchange + migration) / steps_total if steps_total > 0 else float("nan"),
-                    "exchange_mb": exchange_mb,
+                    "exchange_mb": exchange_mb, **split,
                     "peak_rss_mib": round(int(open(mem).read().split()[-1]) / 1024, 1)})
     r = results[-1]
     print(f"  {name}: {n} twisting steps, {r['step_s']:.2f} s per step (assembly {r['assembly_s']:.2f}, "

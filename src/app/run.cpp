@@ -213,34 +213,6 @@ int global_signal(const Teuchos::RCP<const Comm>& comm) {
   return any;
 }
 
-// build_setup with each rank sampling its id block of the particles. The
-// block's start checks differ between ranks: a bad input on any rank is bad
-// input on every rank, with the message of the lowest such rank (the first
-// particle in id order for one check).
-template <int dim>
-SimulationSetup<dim> setup_on_ranks(const Scene& scene, const Comm& comm) {
-  SimulationSetup<dim> setup;
-  std::string error;
-  try {
-    setup = build_setup<dim>(scene, ParticleBlock{comm.getRank(), comm.getSize()});
-  } catch (const std::invalid_argument& e) {
-    error = e.what();
-  }
-  if (comm.getSize() == 1) {
-    if (!error.empty()) throw std::invalid_argument(error);
-    return setup;
-  }
-  const int mine = error.empty() ? comm.getSize() : comm.getRank();
-  int from = mine;
-  Teuchos::reduceAll(comm, Teuchos::REDUCE_MIN, mine, Teuchos::outArg(from));
-  if (from == comm.getSize()) return setup;
-  int n = static_cast<int>(error.size());
-  Teuchos::broadcast(comm, from, Teuchos::outArg(n));
-  error.resize(n);
-  if (n > 0) Teuchos::broadcast(comm, from, n, error.data());
-  throw std::invalid_argument(error);
-}
-
 template <int dim>
 RunSummary run_dim(const Scene& scene, const std::string& dir, const Teuchos::RCP<const Comm>& comm,
                    std::ostream& log_root, const RunOptions& opt) {
@@ -251,7 +223,8 @@ RunSummary run_dim(const Scene& scene, const std::string& dir, const Teuchos::RC
   const bool root = comm->getRank() == 0;
   std::ostream null_log(nullptr);
   std::ostream& log = root ? log_root : null_log;  // one banner, one summary
-  Simulation<dim> sim(setup_on_ranks<dim>(scene, *comm), comm);
+  // Each rank samples its id block of the particles (its start checks agreed).
+  Simulation<dim> sim(build_setup<dim>(scene, particle_block(*comm)), comm);
   if (opt.restart) {
     check_same_mesh(*opt.restart, sim);
     sim.restore(checkpoint_state<dim>(*opt.restart));

@@ -7,6 +7,7 @@
 #include <regex>
 #include <sstream>
 
+#include "core/collective_check.hpp"
 #include "io/gmsh_reader.hpp"
 #include "io/scene_checks.hpp"
 #include "io/scene_explicit.hpp"
@@ -184,6 +185,12 @@ Vec<dim> vecd(const Array<double>& a, const std::string& key) {
   return v;
 }
 
+// A start check of this rank's particles, through the block's agreement.
+void block_check(const ParticleBlock& block, const std::function<void()>& check) {
+  if (block.check) block.check(check);
+  else check();
+}
+
 template <int dim>
 void build_mpm(const Scene& scene, const std::vector<std::string>& mat_names, ParticleBlock block,
                SimulationSetup<dim>& setup) {
@@ -219,6 +226,7 @@ void build_mpm(const Scene& scene, const std::vector<std::string>& mat_names, Pa
     MeshData mesh;
     int material = 0;
     long long count = 0;
+    std::array<double, 3> v0{0, 0, 0};
   };
   std::vector<Body> shapes;
   shapes.reserve(bodies.numParams());  // (shape.mesh points into the list)
@@ -250,6 +258,7 @@ void build_mpm(const Scene& scene, const std::vector<std::string>& mat_names, Pa
     } catch (const std::invalid_argument& e) {
       rethrow_under(body.key, shape.kind, e);
     }
+    body.v0 = vec3(b.get<Array<double>>("initial velocity"), dim, body.key + "/initial velocity");
     mpm.body_names.push_back(name);
   }
   long long total = 0;
@@ -269,9 +278,7 @@ void build_mpm(const Scene& scene, const std::vector<std::string>& mat_names, Pa
     } catch (const std::invalid_argument& e) {
       rethrow_under(body.key, body.shape.kind, e);
     }
-    const std::string& name = mpm.body_names[i];
-    const auto v0 = vec3(bodies.sublist(name).get<Array<double>>("initial velocity"), dim, body.key + "/initial velocity");
-    for (int d = 0; d < dim; ++d) Kokkos::deep_copy(Kokkos::subview(part.v, Kokkos::ALL(), d), v0[d]);
+    for (int d = 0; d < dim; ++d) Kokkos::deep_copy(Kokkos::subview(part.v, Kokkos::ALL(), d), body.v0[d]);
     parts.push_back(part);
   }
   mpm.particles = concatenate(parts);
@@ -279,11 +286,13 @@ void build_mpm(const Scene& scene, const std::vector<std::string>& mat_names, Pa
     mpm.particle_first = first;
     mpm.particle_total = total;
   }
-  check_mpm_start(mpm);
-  for (std::size_t a = 0; a < shapes.size(); ++a)
-    for (std::size_t b = a + 1; b < shapes.size(); ++b) {
-      double x[dim];
-      if (!first_shared_point<dim>(shapes[a].shape, shapes[b].shape, dx, ppc, x)) continue;
+  block_check(block, [&] { check_mpm_start(mpm); });
+  {
+    std::vector<SamplingShape> all;
+    for (const Body& b : shapes) all.push_back(b.shape);
+    int a = 0, b = 0;
+    double x[dim];
+    if (first_overlapping_pair<dim>(all, dx, ppc, a, b, x)) {
       std::string at;
       for (int d = 0; d < dim; ++d) at += (d ? ", " : "") + num(x[d]);
       throw std::invalid_argument("MPM body '" + mpm.body_names[a] + "' and MPM body '" + mpm.body_names[b] +
@@ -291,6 +300,7 @@ void build_mpm(const Scene& scene, const std::vector<std::string>& mat_names, Pa
                                   ") (their samplings share a sub-cell centre); move their 'center' or change "
                                   "their sizes so the bodies are apart");
     }
+  }
   setup.mpm = mpm;
   const auto& lss = p.sublist("Level Sets");
   for (auto it = lss.begin(); it != lss.end(); ++it) {
@@ -350,7 +360,7 @@ void build_mpm(const Scene& scene, const std::vector<std::string>& mat_names, Pa
     }
     setup.level_sets.push_back(ls);
   }
-  check_level_set_start(*setup.mpm, setup.level_sets);
+  block_check(block, [&] { check_level_set_start(*setup.mpm, setup.level_sets); });
 }
 
 }  // namespace
@@ -375,6 +385,15 @@ Scene load_scene(const std::string& path, const std::vector<std::string>& overri
 Scene load_scene_from_string(const std::string& yaml, const std::string& base_dir,
                              const std::vector<std::string>& overrides) {
   return finish(*parse_scene_yaml(yaml, "scene"), "", base_dir, overrides);
+}
+
+ParticleBlock particle_block(const Teuchos::Comm<int>& comm) {
+  ParticleBlock b;
+  b.rank = comm.getRank();
+  b.count = comm.getSize();
+  const Teuchos::Comm<int>* c = &comm;
+  b.check = [c](const std::function<void()>& check) { collective_check(*c, check); };
+  return b;
 }
 
 template <int dim>

@@ -3,7 +3,9 @@
 // full schema (unknown keys, wrong types and bad values stop the run before the
 // first step with a message naming the key, the value and what was expected),
 // defaults filled in, and turned into the solver's set-up structures.
+#include <Teuchos_Comm.hpp>
 #include <Teuchos_ParameterList.hpp>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -37,19 +39,28 @@ Scene load_scene_from_string(const std::string& yaml, const std::string& base_di
 
 // Which particles build_setup samples: with count > 1, only the id block
 // [id_block_begin(N, rank, count), id_block_begin(N, rank + 1, count)) of
-// the N particles of all MPM bodies (MpmSetup::particle_first/_total set;
-// an MPI run passes its rank and size, and no rank holds the whole set);
-// count 1: every particle.
+// the N particles of all MPM bodies (MpmSetup::particle_first/_total set),
+// so that no MPI rank holds the whole set; count 1: every particle.
+// The start checks of the block's particles (inside the grid, outside the
+// level-set solids) run through `check` (empty: called directly). Their
+// verdict differs between ranks, so an MPI run must agree on it:
+// particle_block(comm) sets check to collective_check. Every other check of
+// build_setup is the same on every rank.
 struct ParticleBlock {
   int rank = 0;
   int count = 1;
+  std::function<void(const std::function<void()>&)> check;
 };
 
+// This rank's block of comm, its start checks agreed over comm (collective
+// inside build_setup; comm must outlive the block).
+ParticleBlock particle_block(const Teuchos::Comm<int>& comm);
+
 // Builds meshes (files or Gmsh shapes), materials, motions and solver settings.
-// The start checks on particles (inside the grid, outside level-set solids)
-// see only the block's particles: with count > 1 the callers agree on the
-// verdict (app/run.cpp). Bodies that overlap are refused from their shapes,
-// the same on every rank.
+// On several ranks (a ParticleBlock of count > 1) every rank gives the error,
+// and the same one, that one rank would give with the whole scene: the
+// checks before a block's are the same everywhere, and the first particle in
+// id order that fails a check is the lowest failing rank's.
 template <int dim>
 SimulationSetup<dim> build_setup(const Scene& scene, ParticleBlock block = {});
 

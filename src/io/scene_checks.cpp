@@ -211,16 +211,14 @@ void check_level_set_start(const MpmSetup<dim>& mpm, const std::vector<LevelSet>
   if (level_sets.empty()) return;
   auto x = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), mpm.particles.x);
   auto body = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), mpm.particles.body);
-  for (const LevelSet& ls : level_sets)
-    for (std::size_t q = 0; q < x.extent(0); ++q) {
+  for (std::size_t q = 0; q < x.extent(0); ++q)  // particles first: the first in id order is named
+    for (const LevelSet& ls : level_sets) {
       Vec<dim> p;
-      std::string at = "(";
-      for (int d = 0; d < dim; ++d) {
-        p[d] = x(q, d);
-        at += (d ? ", " : "") + num(x(q, d));
-      }
+      for (int d = 0; d < dim; ++d) p[d] = x(q, d);
       const double phi = ls.phi<dim>(p, 0.0);
-      if (phi < 0)
+      if (!(phi < 0)) continue;
+      std::string at = "(";
+      for (int d = 0; d < dim; ++d) at += (d ? ", " : "") + num(x(q, d));
         throw std::invalid_argument("MPM body '" + mpm.body_names.at(body(q)) + "': particle at " + at +
                                     ")" + " starts inside the solid of level set '" + ls.name +
                                     "' (scene key 'Level Sets/" + ls.name + "', phi = " + num(phi) +

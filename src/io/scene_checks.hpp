@@ -34,9 +34,9 @@ constexpr double kMaxSteps = 1e9;
 template <int dim>
 void check_mpm_start(const MpmSetup<dim>& mpm);
 
-// Refuses a particle that starts inside the solid of a level set (phi < 0 at
-// t = 0), naming the body and the level set: its grid nodes would be
-// constrained to the boundary's motion from the first step.
+// Refuses the first particle (in row order) that starts inside the solid of
+// a level set (phi < 0 at t = 0), naming the body and the level set: its
+// grid nodes would be constrained to the boundary's motion from the first step.
 template <int dim>
 void check_level_set_start(const MpmSetup<dim>& mpm, const std::vector<LevelSet>& level_sets);
 

@@ -131,15 +131,18 @@ class MpmBodies {
   // This rank's particles (all of them on one rank).
   const Particles<dim>& particles() const { return setup_.particles; }
 
-  // MPI: cut the particles into boxes and keep this rank's (every rank has
-  // the scene's whole set here); grid nodes get the global system ids
-  // global_first + grid index. No-op on one rank.
+  // MPI: the particles into boxes, each rank keeping its box's: from every
+  // rank's id block (MpmSetup::particle_total >= 0: replace_particle_block)
+  // or from the whole set on every rank (particle_total < 0:
+  // replace_particles). Grid nodes get the global system ids global_first +
+  // grid index. No-op on one rank (where an id block must be every particle:
+  // the Simulation checks it).
   void distribute(const Teuchos::RCP<const Teuchos::Comm<int>>& comm, GO global_first);
   bool distributed() const { return distributed_; }
   // Restart: the whole particle set of a checkpoint (re-cut when distributed).
   void replace_particles(const Particles<dim>& all);
-  // Restart from this rank's id block of a checkpoint (ids first .. first +
-  // mine.size() - 1 of total; collective). Several ranks: the blocks must
+  // This rank's id block of the particles, from a checkpoint or the scene's
+  // sampling (ids first .. first + mine.size() - 1 of total; collective). Several ranks: the blocks must
   // tile 0..total-1 in rank order (std::invalid_argument on every rank
   // otherwise); boxes cut from the cell-layer counts summed over the ranks
   // (rebalanced_boxes on the scene's layout: 'MPM/boxes per axis' or the

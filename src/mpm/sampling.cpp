@@ -214,15 +214,21 @@ struct ShapeLattice {
   }
 };
 
+// Points per axis and cell for ppc (throws for a ppc not available in dim).
 template <int dim>
-ShapeLattice<dim> shape_lattice(const SamplingShape& shape, double dx, int ppc) {
+int points_per_axis(int ppc) {
+  for (int k = 1; k <= (dim == 2 ? 4 : 3); ++k)
+    if (static_cast<int>(std::pow(k, dim) + 0.5) == ppc) return k;
+  bad("ppc", std::to_string(ppc), dim == 2 ? "one of 1, 4, 9, 16 in 2D" : "one of 1, 8, 27 in 3D");
+}
+
+// with_marks false: a mesh shape's inside flags are left for add_marks (a
+// lattice only compared by its range).
+template <int dim>
+ShapeLattice<dim> shape_lattice(const SamplingShape& shape, double dx, int ppc, bool with_marks = true) {
   validate_shape(shape, dim);
   require_positive("dx", dx);
-  int s = 0;  // points per axis and cell
-  for (int k = 1; k <= (dim == 2 ? 4 : 3); ++k)
-    if (static_cast<int>(std::pow(k, dim) + 0.5) == ppc) s = k;
-  if (s == 0)
-    bad("ppc", std::to_string(ppc), dim == 2 ? "one of 1, 4, 9, 16 in 2D" : "one of 1, 8, 27 in 3D");
+  const int s = points_per_axis<dim>(ppc);
   Vec<dim> lo, hi;
   bounding_box<dim>(shape, lo, hi);
   ShapeLattice<dim> S;
@@ -238,9 +244,42 @@ ShapeLattice<dim> shape_lattice(const SamplingShape& shape, double dx, int ppc) 
     S.L.m_lo[d] = static_cast<long long>(c_lo) * s;
     S.L.count[d] = static_cast<long long>(std::max(1.0, c_hi - c_lo)) * s;
   }
-  if (shape.kind == "mesh") S.mark = mesh_marks<dim>(*shape.mesh, S.L);
+  if (shape.kind == "mesh" && with_marks) S.mark = mesh_marks<dim>(*shape.mesh, S.L);
   S.c = center_of<dim>(shape);
   return S;
+}
+
+template <int dim>
+void add_marks(ShapeLattice<dim>& S) {
+  if (S.shape->kind == "mesh" && S.mark.empty()) S.mark = mesh_marks<dim>(*S.shape->mesh, S.L);
+}
+
+// The first lattice point inside both (x fastest over the intersection of
+// their ranges); false when there is none.
+template <int dim>
+bool first_shared(ShapeLattice<dim>& A, ShapeLattice<dim>& B, double* x) {
+  long long lo[dim], hi[dim], ha[dim], hb[dim];
+  A.last(ha);
+  B.last(hb);
+  for (int d = 0; d < dim; ++d) {
+    lo[d] = std::max(A.L.m_lo[d], B.L.m_lo[d]);
+    hi[d] = std::min(ha[d], hb[d]);
+    if (hi[d] < lo[d]) return false;  // the ranges do not meet (no marks needed)
+  }
+  add_marks(A);
+  add_marks(B);
+  bool found = false;
+  long long at[dim];
+  for_each_point<dim>(lo, hi, [&](const long long* m) {
+    if (found || !A.inside(m) || !B.inside(m)) return;
+    found = true;
+    std::copy(m, m + dim, at);
+  });
+  if (found) {
+    const Vec<dim> p = A.L.point(at);
+    for (int d = 0; d < dim; ++d) x[d] = p[d];
+  }
+  return found;
 }
 
 // Calls keep(k, x) for the inside points k = 0, 1, ... (x fastest) and
@@ -276,17 +315,20 @@ Particles<dim> sample_particles(const SamplingShape& shape, double dx, int ppc, 
 template <int dim>
 Particles<dim> sample_particles(const SamplingShape& shape, double dx, int ppc, double density, int body_id,
                                 int material_id, long long first, long long count) {
-  const ShapeLattice<dim> S = shape_lattice<dim>(shape, dx, ppc);
+  validate_shape(shape, dim);  // (the checks in their order before the work of the lattice)
+  require_positive("dx", dx);
   require_positive("density", density);
+  points_per_axis<dim>(ppc);
   if (body_id < 0) bad("body_id", std::to_string(body_id), ">= 0");
   if (material_id < 0) bad("material_id", std::to_string(material_id), ">= 0");
   if (first < 0) bad("first", std::to_string(first), ">= 0");
+  const ShapeLattice<dim> S = shape_lattice<dim>(shape, dx, ppc);
   const long long end = count < 0 ? std::numeric_limits<long long>::max() : first + count;
   std::vector<Vec<dim>> kept;
   const long long total = scan_inside(S, dx, ppc, [&](long long k, const Vec<dim>& x) {
     if (k >= first && k < end) kept.push_back(x);
   });
-  if (count >= 0 && end > total)
+  if (first > total || (count >= 0 && end > total))
     bad("first", std::to_string(first), "a range of " + std::to_string(count) + " particles inside the shape's " +
                                              std::to_string(total));
 
@@ -314,26 +356,19 @@ Particles<dim> sample_particles(const SamplingShape& shape, double dx, int ppc, 
 
 template <int dim>
 bool first_shared_point(const SamplingShape& a, const SamplingShape& b, double dx, int ppc, double* x) {
-  const ShapeLattice<dim> A = shape_lattice<dim>(a, dx, ppc), B = shape_lattice<dim>(b, dx, ppc);
-  long long lo[dim], hi[dim], ha[dim], hb[dim];
-  A.last(ha);
-  B.last(hb);
-  for (int d = 0; d < dim; ++d) {
-    lo[d] = std::max(A.L.m_lo[d], B.L.m_lo[d]);
-    hi[d] = std::min(ha[d], hb[d]);
-  }
-  bool found = false;
-  long long at[dim];
-  for_each_point<dim>(lo, hi, [&](const long long* m) {
-    if (found || !A.inside(m) || !B.inside(m)) return;
-    found = true;
-    std::copy(m, m + dim, at);
-  });
-  if (found) {
-    const Vec<dim> p = A.L.point(at);
-    for (int d = 0; d < dim; ++d) x[d] = p[d];
-  }
-  return found;
+  ShapeLattice<dim> A = shape_lattice<dim>(a, dx, ppc, false), B = shape_lattice<dim>(b, dx, ppc, false);
+  return first_shared(A, B, x);
+}
+
+template <int dim>
+bool first_overlapping_pair(const std::vector<SamplingShape>& shapes, double dx, int ppc, int& a, int& b, double* x) {
+  std::vector<ShapeLattice<dim>> S;
+  S.reserve(shapes.size());
+  for (const SamplingShape& s : shapes) S.push_back(shape_lattice<dim>(s, dx, ppc, false));
+  for (a = 0; a < static_cast<int>(S.size()); ++a)
+    for (b = a + 1; b < static_cast<int>(S.size()); ++b)
+      if (first_shared(S[a], S[b], x)) return true;
+  return false;
 }
 
 template <int dim>
@@ -368,6 +403,8 @@ template long long count_particles<2>(const SamplingShape&, double, int);
 template long long count_particles<3>(const SamplingShape&, double, int);
 template bool first_shared_point<2>(const SamplingShape&, const SamplingShape&, double, int, double*);
 template bool first_shared_point<3>(const SamplingShape&, const SamplingShape&, double, int, double*);
+template bool first_overlapping_pair<2>(const std::vector<SamplingShape>&, double, int, int&, int&, double*);
+template bool first_overlapping_pair<3>(const std::vector<SamplingShape>&, double, int, int&, int&, double*);
 template std::string sampling_report<2>(const SamplingShape&, const Particles<2>&, double, int);
 template std::string sampling_report<3>(const SamplingShape&, const Particles<3>&, double, int);
 

@@ -71,6 +71,12 @@ long long count_particles(const SamplingShape& shape, double dx, int ppc);
 template <int dim>
 bool first_shared_point(const SamplingShape& a, const SamplingShape& b, double dx, int ppc, double* x);
 
+// The first pair a < b of the shapes (in that order: a, then b) that share a
+// point, the point in x; false if none. Each shape's lattice is made once,
+// and a mesh shape's inside flags only for a pair whose lattices meet.
+template <int dim>
+bool first_overlapping_pair(const std::vector<SamplingShape>& shapes, double dx, int ppc, int& a, int& b, double* x);
+
 // Exact area (2D) or volume (3D) of the shape: analytic for box, disk,
 // sphere, ring and half-ring, total_measure(*mesh) for mesh, NaN for sdf.
 // Expects a shape that sample_particles accepts.

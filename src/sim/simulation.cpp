@@ -8,40 +8,10 @@
 #include <iostream>
 #include <sstream>
 
+#include "core/collective_check.hpp"
 #include "solver/solver_error.hpp"
 
 namespace bfemp {
-
-namespace {
-// Runs check on every rank; when it throws std::invalid_argument on any,
-// every rank throws the message of the lowest rank that failed (rank 0
-// reports it).
-void collective_check(const Comm& comm, const std::function<void()>& check) {
-  std::string msg;
-  int failed = 0;
-  try {
-    check();
-  } catch (const std::invalid_argument& e) {
-    msg = e.what();
-    failed = 1;
-  }
-  if (comm.getSize() == 1) {
-    if (failed) throw std::invalid_argument(msg);
-    return;
-  }
-  const int mine = failed ? comm.getRank() : std::numeric_limits<int>::max();
-  int first = 0;
-  Teuchos::reduceAll(comm, Teuchos::REDUCE_MIN, mine, Teuchos::outArg(first));
-  if (first == std::numeric_limits<int>::max()) return;
-  int len = static_cast<int>(msg.size());
-  Teuchos::broadcast(comm, first, Teuchos::outArg(len));
-  std::string text(static_cast<std::size_t>(len), ' ');
-  if (comm.getRank() == first) text = msg;
-  if (len > 0) Teuchos::broadcast(comm, first, len, text.data());
-  throw std::invalid_argument(text);
-}
-
-}  // namespace
 
 using View1 = Kokkos::View<double*, MemSpace>;
 
@@ -72,6 +42,11 @@ Simulation<dim>::Simulation(SimulationSetup<dim> setup, const Teuchos::RCP<const
   elasticity_ = std::make_unique<DeformationTerm<dim, dim + 1>>("fem elasticity", mesh_.elements);
   if (mesh_.num_cells() > 0) elasticity_->set_coloring(color_stencils<dim + 1>(mesh_.elements.nodes, mesh_.num_nodes()));
   if (setup_.mpm) {
+    const auto& ms = *setup_.mpm;
+    if (comm->getSize() == 1 && ms.particle_total >= 0 &&
+        (ms.particle_first != 0 || static_cast<long long>(ms.particles.size()) != ms.particle_total))
+      throw std::logic_error("Simulation: one rank with the particle block " + std::to_string(ms.particle_first) +
+                             ".. of " + std::to_string(ms.particle_total) + " (a ParticleBlock of another rank count)");
     mpm_ = std::make_unique<MpmBodies<dim>>(*setup_.mpm, mesh_.elements.materials);
     const auto pm = mpm_->particles().mass;
     double m = std::numeric_limits<double>::infinity();

@@ -107,8 +107,13 @@ void Simulation<dim>::restore(const SimulationState<dim>& s) {
     }
     g.dx = s.grid_dx;
     mpm_->restore_grid(g, s.grid_extensions);
-    if (s.particle_block)
-      mpm_->replace_particle_block(p, s.particle_first, total);  // (MPI: boxes cut on the checkpoint's grid)
+    if (s.particle_block) {
+      try {
+        mpm_->replace_particle_block(p, s.particle_first, total);  // (MPI: boxes cut on the checkpoint's grid)
+      } catch (const std::invalid_argument& e) {
+        throw std::invalid_argument(std::string("restart: ") + e.what());
+      }
+    }
     else
       mpm_->replace_particles(p);
     if (!s.particle_order.empty() && !mpm_->distributed()) mpm_->restore_order(s.particle_order);

@@ -157,7 +157,7 @@ SceneResult run_scene_steps(const std::string& file, const std::vector<std::stri
   const Scene scene = load_scene(std::string(BFEMP_SOURCE_DIR) + "/inputs/" + file, o);
   // Each rank samples its id block of the particles, as `bfemp run` does
   // (alone: every particle).
-  Simulation<2> sim(build_setup<2>(scene, ParticleBlock{comm->getRank(), comm->getSize()}), comm);
+  Simulation<2> sim(build_setup<2>(scene, particle_block(*comm)), comm);
   SceneResult out;
   out.r.momentum0 = sim.diagnostics().momentum;
   for (int s = 0; s < steps; ++s) {
@@ -262,6 +262,43 @@ TEST(MpmMpi, ParticleStartingInsideAnFemBodyStopsEveryRank) {
   Teuchos::reduceAll(*world, Teuchos::REDUCE_MIN, len, Teuchos::outArg(lo));
   Teuchos::reduceAll(*world, Teuchos::REDUCE_MAX, len, Teuchos::outArg(hi));
   EXPECT_EQ(lo, hi) << "the ranks stopped with different messages";
+}
+
+// A scene of 2 particles sampled by id blocks: on 3 ranks rank 0's block is
+// empty (and on 2 ranks each holds one); the particles fall under gravity
+// and the run equals one rank alone.
+TEST(MpmMpi, SceneWithEmptyParticleBlocksEqualsOneRank) {
+  auto world = Tpetra::getDefaultComm();
+  Teuchos::RCP<const Comm> self = Teuchos::rcp(new Teuchos::MpiComm<int>(MPI_COMM_SELF));
+  const std::string yaml = R"(bfemp:
+  dimension: 2
+  gravity: [0.0, -10.0]
+  Time: {dt: 1.0e-2, end time: 0.05, integrator: backward-euler}
+  Newton: {eps_d: 1.0e-9}
+  Materials:
+    soft: {E: 1.0e4, nu: 0.3, density: 1000.0}
+  MPM: {grid spacing: 0.1, domain min: [0.0, 0.0], domain max: [1.0, 1.0], particles per cell: 1}
+  MPM Bodies:
+    pair: {material: soft, shape: box, center: [0.5, 0.6], size: [0.1, 0.2]}
+  Linear Solver: {type: CG, CG: {tolerance: 1.0e-13}}
+)";
+  const Scene scene = load_scene_from_string(yaml, ".");
+  auto run = [&](const Teuchos::RCP<const Comm>& comm) {
+    SimulationSetup<2> setup = build_setup<2>(scene, particle_block(*comm));
+    EXPECT_EQ(static_cast<long long>(setup.mpm->particles.size()),
+              2LL * (comm->getRank() + 1) / comm->getSize() - 2LL * comm->getRank() / comm->getSize());
+    Simulation<2> sim(std::move(setup), comm);
+    EXPECT_EQ(sim.mpm()->total_particles(), 2);
+    return run_steps(sim, 5);
+  };
+  const Result d = run(world);
+  const Result s = run(self);
+  compare<2>(*world, d, s, 1e-9, "2 particles");
+  if (world->getRank() == 0) {
+    ASSERT_EQ(d.x.size(), 4u);
+    // Free fall over 5 backward-Euler steps: y drops by g dt^2 (1 + ... + 5).
+    EXPECT_NEAR(d.x[1], 0.55 - 10.0 * 1e-4 * 15, 1e-6);
+  }
 }
 
 // 'MPM/when particles leave: extend' on 2 ranks: both blocks move right

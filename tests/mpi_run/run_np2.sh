@@ -99,17 +99,21 @@ echo "refusals on 2 ranks: direct solver, FEM-FEM contact, explicit scene, boxes
 # bad start found on one rank (the column's top, rank 1's block, above the
 # grid) or on both (the ground raised into the column) stops both ranks with
 # exit 2 and the message 1 rank gives (the first particle in id order).
-for bad in "MPM/domain max=[0.5, 0.8]" "Level Sets/ground/point=[0.0, 0.6]"; do
+# Both at once (the top above the grid: rank 1; the bottom in the ground:
+# rank 0): the grid's message, the check 1 rank makes first.
+for bad in "MPM/domain max=[0.5, 0.8]" "Level Sets/ground/point=[0.0, 0.6]" "MPM/domain max=[0.5, 0.8]|Level Sets/ground/point=[0.0, 0.3]"; do
+  sets=(); IFS='|' read -ra keys <<< "$bad"; for k in "${keys[@]}"; do sets+=(--set "$k"); done
   for np in 1 2; do
     set +e
     "${mpi[@]}" -np $np "$exe" run "$src/inputs/mpm_column.yaml" --output "$work/bad_start$np" \
-      --set 'Linear Solver/type=CG' --set "$bad" > "$work/bad_start$np.log" 2>&1; rc=$?
+      --set 'Linear Solver/type=CG' "${sets[@]}" > "$work/bad_start$np.log" 2>&1; rc=$?
     set -e
     [ $rc = 2 ] || { echo "bad start ($bad) on $np rank(s): exit $rc"; cat "$work/bad_start$np.log"; exit 1; }
     [ ! -e "$work/bad_start$np/bfemp.h5" ] || { echo "the refused run ($bad) wrote output"; exit 1; }
   done
   m1=$(grep "bad input" "$work/bad_start1.log"); m2=$(grep "bad input" "$work/bad_start2.log")
   [ -n "$m1" ] && [ "$m1" = "$m2" ] || { echo "bad start ($bad): 1 rank '$m1', 2 ranks '$m2'"; cat "$work/bad_start2.log"; exit 1; }
+  case "$bad" in MPM/domain*) echo "$m1" | grep -q "outside the MPM grid domain" || { echo "bad start ($bad): '$m1'"; exit 1; } ;; esac
 done
 echo "bad starts found by one rank's particle block or by both: exit 2 on 2 ranks, the 1-rank message"
 # MPM bodies alone on 2 ranks.

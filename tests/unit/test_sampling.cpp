@@ -342,3 +342,34 @@ TEST(Sampling, SharedPointMatchesTheSamplings) {
   expect_shared_point<3>(shape("box", {0.0, 0.0, 0.0}, {0.4, 0.4, 0.4}), shape("sphere", {0.45, 0.0, 0.0}, {}, 0.0, 0.2),
                          0.1, 8, false);
 }
+
+// The first overlapping pair of several shapes, in pair order (a, then b):
+// each shape's lattice made once; pairs whose lattices do not meet skipped.
+TEST(Sampling, FirstOverlappingPairInPairOrder) {
+  ShapeSpec disk;
+  disk.kind = "disk";
+  disk.center = {1.0, 0.0};
+  disk.outer_radius = 0.2;
+  disk.element_size = 0.05;
+  const MeshData mesh = mesh_shape(disk, 2);
+  SamplingShape m;
+  m.kind = "mesh";
+  m.mesh = &mesh;
+  const std::vector<SamplingShape> shapes = {shape("box", {-1.0, 0.0}, {0.2, 0.2}), m,
+                                             shape("disk", {1.25, 0.0}, {}, 0.0, 0.1),
+                                             shape("disk", {-0.85, 0.0}, {}, 0.0, 0.1)};
+  int a = -1, b = -1;
+  double x[2];
+  ASSERT_TRUE(first_overlapping_pair<2>(shapes, 0.05, 4, a, b, x));
+  EXPECT_EQ(a, 0);  // the box and the last disk before the mesh and the middle disk
+  EXPECT_EQ(b, 3);
+  double y[2];
+  ASSERT_TRUE(first_shared_point<2>(shapes[0], shapes[3], 0.05, 4, y));
+  EXPECT_EQ(x[0], y[0]);
+  EXPECT_EQ(x[1], y[1]);
+  const std::vector<SamplingShape> apart = {shapes[0], shapes[1], shapes[2]};
+  ASSERT_TRUE(first_overlapping_pair<2>(apart, 0.05, 4, a, b, x));
+  EXPECT_EQ(a, 1);
+  EXPECT_EQ(b, 2);
+  EXPECT_FALSE(first_overlapping_pair<2>({shapes[0], shapes[2]}, 0.05, 4, a, b, x));
+}

@@ -227,23 +227,34 @@ TEST(SceneInput, OverlappingBodiesAreRefusedNamingBoth) {
 // (positions, initial velocities, masses, bodies, materials), the block
 // starts are id_block_begin and the total is the whole count.
 TEST(SceneInput, ParticleBlocksTileTheScenesParticlesInIdOrder) {
-  const Scene scene = load(kScene, {"MPM Bodies/right/initial velocity=[1.5, -2.0]",
-                                    "MPM Bodies/right/material=hard"});
+  // Three bodies of 16, 24 and 12 particles (dx 0.1, 4 per cell): a block
+  // edge falls inside each, and their offsets differ.
+  const std::string three =
+      replaced(kScene, "    right: {material: soft, shape: box, center: [0.7, 0.5], size: [0.2, 0.2]}\n",
+               "    right: {material: soft, shape: box, center: [0.7, 0.5], size: [0.2, 0.3]}\n"
+               "    top: {material: soft, shape: disk, center: [0.5, 0.85], outer radius: 0.1}\n");
+  const Scene scene = load(three, {"MPM Bodies/right/initial velocity=[1.5, -2.0]", "MPM Bodies/right/material=hard",
+                                   "MPM Bodies/top/initial velocity=[0.0, 3.0]"});
   const SimulationSetup<2> whole = build_setup<2>(scene);
   const Particles<2>& w = whole.mpm->particles;
   const long long n = static_cast<long long>(w.size());
-  ASSERT_EQ(n, 32);  // two 0.2 x 0.2 boxes, dx 0.1, 4 per cell
+  ASSERT_EQ(whole.mpm->body_names.size(), 3u);
+  ASSERT_EQ(n, 16 + 24 + 12);
   EXPECT_EQ(whole.mpm->particle_total, -1);
   auto wx = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), w.x);
   auto wv = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), w.v);
   auto wm = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), w.mass);
   auto wb = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), w.body);
   auto wmat = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), w.material);
-  ASSERT_NE(wmat(0), wmat(n - 1));
-  for (int R : {2, 3, 5, 16, 40}) {
+  ASSERT_NE(wmat(0), wmat(20));
+  ASSERT_EQ(wb(15), 0);
+  ASSERT_EQ(wb(16), 1);
+  ASSERT_EQ(wb(40), 2);
+  ASSERT_EQ(wv(45, 1), 3.0);
+  for (int R : {2, 3, 5, 7, 16, 60}) {
     long long row = 0;
     for (int r = 0; r < R; ++r) {
-      const SimulationSetup<2> part = build_setup<2>(scene, ParticleBlock{r, R});
+      const SimulationSetup<2> part = build_setup<2>(scene, ParticleBlock{r, R, {}});
       const Particles<2>& p = part.mpm->particles;
       EXPECT_EQ(part.mpm->particle_total, n);
       EXPECT_EQ(part.mpm->particle_first, n * r / R) << "R " << R << " r " << r;
@@ -266,7 +277,7 @@ TEST(SceneInput, ParticleBlocksTileTheScenesParticlesInIdOrder) {
     }
     EXPECT_EQ(row, n) << "R " << R;
   }
-  EXPECT_THROW(build_setup<2>(scene, ParticleBlock{2, 2}), std::logic_error);
+  EXPECT_THROW(build_setup<2>(scene, ParticleBlock{2, 2, {}}), std::logic_error);
 }
 
 TEST(SceneInput, EmptyMaterialAndNewmarkAndStepCount) {
