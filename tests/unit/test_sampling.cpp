@@ -32,6 +32,23 @@ SamplingShape shape(const std::string& kind, std::vector<double> center, std::ve
   return s;
 }
 
+// A Gmsh-meshed 2D disk, and the sampling shape of a mesh.
+MeshData disk_mesh(std::vector<double> center, double radius, double h) {
+  ShapeSpec disk;
+  disk.kind = "disk";
+  disk.center = std::move(center);
+  disk.outer_radius = radius;
+  disk.element_size = h;
+  return mesh_shape(disk, 2);
+}
+
+SamplingShape mesh_of(const MeshData& mesh) {
+  SamplingShape m;
+  m.kind = "mesh";
+  m.mesh = &mesh;
+  return m;
+}
+
 template <int dim>
 double total(const Kokkos::View<double*, MemSpace>& v) {
   double sum = 0.0;
@@ -154,15 +171,8 @@ TEST(Sampling, SignedDistanceMatchesAnalyticDisk) {
 }
 
 TEST(Sampling, ClosedMeshMatchesAnalyticShape) {
-  ShapeSpec disk;
-  disk.kind = "disk";
-  disk.center = {0.05, -0.1};
-  disk.outer_radius = 0.5;
-  disk.element_size = 0.04;
-  const MeshData mesh = mesh_shape(disk, 2);
-  SamplingShape m;
-  m.kind = "mesh";
-  m.mesh = &mesh;
+  const MeshData mesh = disk_mesh({0.05, -0.1}, 0.5, 0.04);
+  SamplingShape m = mesh_of(mesh);
   const std::size_t n_mesh = sample_particles<2>(m, 0.02, 4, 1.0, 0, 0).size();
   const std::size_t n_disk =
       sample_particles<2>(shape("disk", {0.05, -0.1}, {}, 0.0, 0.5), 0.02, 4, 1.0, 0, 0).size();
@@ -286,16 +296,8 @@ TEST(Sampling, RangesTileTheWholeSampling) {
   expect_ranges_tile<2>(shape("ring", {0.1, -0.2}, {}, 0.3, 0.5), 0.05, 4);
   expect_ranges_tile<2>(shape("half-ring", {0.0, 0.0}, {}, 0.2, 0.4), 0.05, 9);
   expect_ranges_tile<3>(shape("box", {0.5, 0.5, 0.5}, {0.3, 0.2, 0.4}), 0.1, 8);
-  ShapeSpec disk;
-  disk.kind = "disk";
-  disk.center = {0.05, -0.1};
-  disk.outer_radius = 0.3;
-  disk.element_size = 0.05;
-  const MeshData mesh = mesh_shape(disk, 2);
-  SamplingShape m;
-  m.kind = "mesh";
-  m.mesh = &mesh;
-  expect_ranges_tile<2>(m, 0.05, 4);
+  const MeshData mesh = disk_mesh({0.05, -0.1}, 0.3, 0.05);
+  expect_ranges_tile<2>(mesh_of(mesh), 0.05, 4);
   // The empty sampling is refused by the count as by the sampling.
   EXPECT_THROW(count_particles<2>(shape("disk", {0.0, 0.0}, {}, 0.0, 1e-4), 0.05, 4), std::invalid_argument);
 }
@@ -346,16 +348,8 @@ TEST(Sampling, SharedPointMatchesTheSamplings) {
 // The first overlapping pair of several shapes, in pair order (a, then b):
 // each shape's lattice made once; pairs whose lattices do not meet skipped.
 TEST(Sampling, FirstOverlappingPairInPairOrder) {
-  ShapeSpec disk;
-  disk.kind = "disk";
-  disk.center = {1.0, 0.0};
-  disk.outer_radius = 0.2;
-  disk.element_size = 0.05;
-  const MeshData mesh = mesh_shape(disk, 2);
-  SamplingShape m;
-  m.kind = "mesh";
-  m.mesh = &mesh;
-  const std::vector<SamplingShape> shapes = {shape("box", {-1.0, 0.0}, {0.2, 0.2}), m,
+  const MeshData mesh = disk_mesh({1.0, 0.0}, 0.2, 0.05);
+  const std::vector<SamplingShape> shapes = {shape("box", {-1.0, 0.0}, {0.2, 0.2}), mesh_of(mesh),
                                              shape("disk", {1.25, 0.0}, {}, 0.0, 0.1),
                                              shape("disk", {-0.85, 0.0}, {}, 0.0, 0.1)};
   int a = -1, b = -1;
