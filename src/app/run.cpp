@@ -27,7 +27,7 @@ namespace {
 const char* kRestartKeys[] = {"Time/end time", "Output/", "Newton/", "Linear Solver/", "MPM/boxes per axis",
                               "Contact/friction iterations",
                               "Contact/friction pass tolerance",
-                              "Contact/check iterates"};
+                              "Contact/check iterates", "Contact/eps_v"};
 
 std::string join_lines(const std::vector<std::string>& v) {
   std::string s;

@@ -158,7 +158,9 @@ double FrictionTerm<dim>::energy(ConstDofView x) const {
 // Per particle q with stencil weights w_a at nodes n_a, over its lagged
 // pairs k with coefficients c_k0 (particle), c_ki (vertices):
 //   pair force     f_k = mu lambda_k (f1/y) T_k u_k,
-//   pair Hessian   Hx_k = mu lambda_k s^2 T_k H_u T_k^T   (mu lambda_k > 0 only),
+//   pair Hessian   Hx_k = a_k mu lambda_k s^2 T_k H_u T_k^T,
+// a_k = 1, except for a compensation pair (mu lambda_k < 0) when projecting:
+// a_k = sink.contact_keep (0 unless Newton's fallback keeps some curvature),
 // the particle's sums s sum_k c_k0 f_k and sum_k c_k0^2 Hx_k are expanded
 // through the stencil once; the vertex parts (s c_ki f_k, c_ki c_kl Hx_k,
 // w_a c_k0 c_ki Hx_k) go per pair. The same sums as expanding each pair's
@@ -175,6 +177,7 @@ void FrictionTerm<dim>::assemble_by_particle(ConstDofView x, const Sink<dim>& si
   const auto ml = ml_;
   const double s = s_, eh = eh_;
   const bool matrix = hessian && sink.has_matrix();
+  const double negative_kept = project_ && sink.project ? sink.contact_keep : 1.0;
   constexpr int ns = ParticleStencils<dim>::ns;
   // As the barrier term: with the cells, the particle sums are expanded cell by cell.
   const ParticleCells<dim>* cells = barrier_.cells();
@@ -200,9 +203,11 @@ void FrictionTerm<dim>::assemble_by_particle(ConstDofView x, const Sink<dim>& si
             vn[i] = sl.prims.nodes(j, i);
             for (int d = 0; d < dim; ++d) sink.add_gradient(vn[i], d, s * c(k, 1 + i) * f(d));
           }
-          // A compensation pair (mu lambda < 0): its negative Hessian projects to zero.
-          if (!matrix || !(ml(k) > 0)) continue;
-          const Mat<dim> Hx = ml(k) * s * s * (T * friction_f0_hessian<dim - 1>(u, eh) * T.transpose());
+          if (!matrix || ml(k) == 0.0) continue;
+          // A compensation pair (mu lambda < 0) projected alone: a fraction of its curvature, or none.
+          const double a = ml(k) > 0 ? 1.0 : negative_kept;
+          if (a == 0.0) continue;
+          const Mat<dim> Hx = (a * ml(k) * s * s) * (T * friction_f0_hessian<dim - 1>(u, eh) * T.transpose());
           const double c0 = c(k, 0);
           Hpp += (c0 * c0) * Hx;
           for (int i = 0; i < nv; ++i) {

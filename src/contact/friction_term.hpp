@@ -9,8 +9,14 @@
 // particle's velocity is the grid velocity interpolated at the particle
 // (paper §4.3), never the particle's own. s = gamma dt^2 / h and x_ref make
 // dt v^{n+1} of the integrator affine in x (backward Euler: s = 1, x_ref =
-// x^n). Its Hessian mu lambda s^2 c c^T (x) T H_u T^T is PSD for lambda > 0;
-// compensation pairs with lambda < 0 contribute their gradient only.
+// x^n). Its Hessian mu lambda s^2 c c^T (x) T H_u T^T is PSD for lambda > 0
+// and NSD for the compensation pairs (lambda < 0). The exact Hessian (a sink
+// with project = false, Newton's exact-if-definite) keeps them: near an edge
+// or vertex they cancel the duplicate curvature of the facets sharing it, and
+// a Hessian without them is up to twice too stiff there (Newton then converges
+// linearly: the A7 twist's friction passes). Projected, each pair is projected
+// alone: a compensation pair's Hessian becomes 0, or keeps the fraction
+// sink.contact_keep of its curvature (Newton's fallback keep).
 #include "contact/barrier_term.hpp"
 
 namespace bfemp {
@@ -38,6 +44,8 @@ class FrictionTerm : public EnergyTerm<dim> {
   void gradient(ConstDofView x, double scale, DofView grad) const override;
   void assemble(ConstDofView x, const Sink<dim>& sink) const override;
   double max_step(ConstDofView, ConstDofView) const override { return std::numeric_limits<double>::infinity(); }
+  void set_projection(bool project) { project_ = project; }  // false: exact Hessian (tests)
+  bool projection() const { return project_; }
   // Friction force on the particles (-dD/dx_q), added into f.
   void add_particle_forces(ConstDofView x, DofView f) const;
 
@@ -58,6 +66,7 @@ class FrictionTerm : public EnergyTerm<dim> {
   Kokkos::View<double* [dim][dim - 1], MemSpace> T_;
   Kokkos::View<double*, MemSpace> ml_;            // mu * lambda
   LO n_ = 0;
+  bool project_ = true;
   Kokkos::View<LO*, MemSpace> seg_;  // n_seg_ + 1 starts of each particle's pairs (capacity grows)
   LO n_seg_ = 0;
   // Scratch of the evaluations (kept for its capacity; every call writes
