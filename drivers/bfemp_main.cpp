@@ -54,7 +54,8 @@ int main(int argc, char** argv) {
   restart->add_option("dir", restart_dir, "output directory of the run to continue")->required();
   restart->add_option("--set", sets,
                       "change a key that leaves the state alone (Time/end time, Output/*, Newton/*, "
-                      "Linear Solver/*, MPM/boxes per axis, Contact/friction iterations, Contact/check iterates)");
+                      "Linear Solver/*, MPM/boxes per axis, Contact/friction iterations, Contact/friction pass tolerance, "
+                      "Contact/check iterates, Contact/eps_v)");
   restart->add_option("--output,-o", restart_output,
                       "write the continuation into a new directory (default: append to DIR)");
   std::string probe_dir;

@@ -158,9 +158,9 @@ double FrictionTerm<dim>::energy(ConstDofView x) const {
 // Per particle q with stencil weights w_a at nodes n_a, over its lagged
 // pairs k with coefficients c_k0 (particle), c_ki (vertices):
 //   pair force     f_k = mu lambda_k (f1/y) T_k u_k,
-//   pair Hessian   Hx_k = a_k mu lambda_k s^2 T_k H_u T_k^T,
-// a_k = 1, except for a compensation pair (mu lambda_k < 0) when projecting:
-// a_k = sink.contact_keep (0 unless Newton's fallback keeps some curvature),
+//   pair Hessian   Hx_k = share_k mu lambda_k s^2 T_k H_u T_k^T,
+// share_k = 1, except for a compensation pair (mu lambda_k < 0) when projecting:
+// share_k = sink.contact_keep (0 unless Newton's fallback keeps some curvature),
 // the particle's sums s sum_k c_k0 f_k and sum_k c_k0^2 Hx_k are expanded
 // through the stencil once; the vertex parts (s c_ki f_k, c_ki c_kl Hx_k,
 // w_a c_k0 c_ki Hx_k) go per pair. The same sums as expanding each pair's
@@ -205,9 +205,9 @@ void FrictionTerm<dim>::assemble_by_particle(ConstDofView x, const Sink<dim>& si
           }
           if (!matrix || ml(k) == 0.0) continue;
           // A compensation pair (mu lambda < 0) projected alone: a fraction of its curvature, or none.
-          const double a = ml(k) > 0 ? 1.0 : negative_kept;
-          if (a == 0.0) continue;
-          const Mat<dim> Hx = (a * ml(k) * s * s) * (T * friction_f0_hessian<dim - 1>(u, eh) * T.transpose());
+          const double share = ml(k) > 0 ? 1.0 : negative_kept;
+          if (share == 0.0) continue;
+          const Mat<dim> Hx = (share * ml(k) * s * s) * (T * friction_f0_hessian<dim - 1>(u, eh) * T.transpose());
           const double c0 = c(k, 0);
           Hpp += (c0 * c0) * Hx;
           for (int i = 0; i < nv; ++i) {

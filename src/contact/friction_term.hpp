@@ -12,8 +12,9 @@
 // x^n). Its Hessian mu lambda s^2 c c^T (x) T H_u T^T is PSD for lambda > 0
 // and NSD for the compensation pairs (lambda < 0). The exact Hessian (a sink
 // with project = false, Newton's exact-if-definite) keeps them: near an edge
-// or vertex they cancel the duplicate curvature of the facets sharing it, and
-// a Hessian without them is up to twice too stiff there (Newton then converges
+// or vertex they cancel the duplicate curvature of the facets sharing it. A
+// Hessian without them is too stiff there: twice at an edge shared by two
+// facets, T + 1 times at a 3D vertex of T triangles (Newton then converges
 // linearly: the A7 twist's friction passes). Projected, each pair is projected
 // alone: a compensation pair's Hessian becomes 0, or keeps the fraction
 // sink.contact_keep of its curvature (Newton's fallback keep).
@@ -45,7 +46,6 @@ class FrictionTerm : public EnergyTerm<dim> {
   void assemble(ConstDofView x, const Sink<dim>& sink) const override;
   double max_step(ConstDofView, ConstDofView) const override { return std::numeric_limits<double>::infinity(); }
   void set_projection(bool project) { project_ = project; }  // false: exact Hessian (tests)
-  bool projection() const { return project_; }
   // Friction force on the particles (-dD/dx_q), added into f.
   void add_particle_forces(ConstDofView x, DofView f) const;
 

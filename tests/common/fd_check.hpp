@@ -171,7 +171,8 @@ struct Assembled {
 
 template <int dim>
 Assembled assemble_dense(const EnergyTerm<dim>& term, LO n_nodes, Kokkos::View<double*, MemSpace> x, double scale,
-                         const std::vector<int>& mask, const HostVec& dx_prescribed, bool project = true) {
+                         const std::vector<int>& mask, const HostVec& dx_prescribed, bool project = true,
+                         double contact_keep = 0.0) {
   const std::size_t nd = static_cast<std::size_t>(n_nodes) * dim;
   auto map = Teuchos::rcp(new Map(nd, 0, Tpetra::getDefaultComm()));
   auto A = Teuchos::rcp(new Matrix(build_dof_graph<dim>({&term}, n_nodes, map)));
@@ -192,6 +193,7 @@ Assembled assemble_dense(const EnergyTerm<dim>& term, LO n_nodes, Kokkos::View<d
   }
   auto sink = make_sink<dim>(A->getLocalMatrixDevice(), scale, grad, rhs, pres, dxp);
   sink.project = project;
+  sink.contact_keep = contact_keep;
   term.assemble(x, sink);
   Kokkos::fence();
   A->fillComplete();
@@ -422,11 +424,12 @@ std::size_t check_sink_exact_hessian(Term& term, LO n_nodes, Kokkos::View<double
   return differ;
 }
 
-// A term whose local Hessians can be indefinite (barrier contact): with its
+// A term whose local Hessians can be indefinite (barrier contact: b' grad^2 d;
+// lagged friction: its compensation pairs, mu lambda < 0): with its
 // projection off, its energy must be positive at x (the case is in contact),
 // gradient and Hessian must match differences entry by entry, and the sink's
 // project = false path must give that exact Hessian, which the projection
-// changes somewhere (b' grad^2 d is indefinite). Leaves the projection on.
+// changes somewhere. Leaves the projection on.
 template <int dim, class Term>
 void check_exact_term(Term& term, LO n_nodes, Kokkos::View<double*, MemSpace> x, double fd_h, double tol) {
   term.set_projection(false);

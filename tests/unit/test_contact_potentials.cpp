@@ -248,8 +248,9 @@ TEST(ContactPotentials, FrictionDerivatives3D) {
 // Hessian against differences of the energy, entry by entry, prescribed DOFs
 // included. Projected, each compensation pair's Hessian is dropped, so the
 // projected matrix must differ (check_exact_term asserts it). Dropping them
-// in the exact Hessian too made it up to twice too stiff near the edges, and
-// the A7 twist's friction passes converged linearly (rate 0.65).
+// in the exact Hessian too made it twice too stiff at shared edges (T + 1
+// times at a 3D vertex of T triangles), and the A7 twist's friction passes
+// converged linearly (rate 0.65).
 template <int dim>
 void friction_exact_case(const std::vector<Vec<dim>>& pts, double slide) {
   auto s = lagged_friction_scene<dim>(pts, slide);
@@ -257,6 +258,21 @@ void friction_exact_case(const std::vector<Vec<dim>>& pts, double slide) {
   auto& friction = *s.contact->friction();
   ASSERT_GT(friction.pairs(), static_cast<LO>(2 * pts.size())) << "expected several pairs per particle";
   fixtures::check_exact_term<dim>(friction, s.n_nodes, s.x, kFdStep, 1e-5);
+  // Newton's fallback (sink.contact_keep = k): a compensation pair keeps the
+  // fraction k of its curvature, so the matrix is the projected one (k = 0)
+  // plus k times what the projection removed; the gradient is the same.
+  using fixtures::fd_detail::assemble_dense;
+  const auto none = assemble_dense<dim>(friction, s.n_nodes, s.x, 1.0, {}, {}, true, 0.0);
+  const auto kept = assemble_dense<dim>(friction, s.n_nodes, s.x, 1.0, {}, {}, true, 0.3);
+  const auto exact = assemble_dense<dim>(friction, s.n_nodes, s.x, 1.0, {}, {}, false);
+  double a_max = 0, g_max = 0;
+  for (double v : exact.A) a_max = std::max(a_max, std::abs(v));
+  for (double v : exact.grad) g_max = std::max(g_max, std::abs(v));
+  std::size_t wrong = 0;
+  for (std::size_t k = 0; k < exact.A.size(); ++k)
+    wrong += std::abs(kept.A[k] - (none.A[k] + 0.3 * (exact.A[k] - none.A[k]))) > 1e-12 * a_max;
+  for (std::size_t i = 0; i < exact.grad.size(); ++i) wrong += std::abs(kept.grad[i] - exact.grad[i]) > 1e-13 * g_max;
+  EXPECT_EQ(wrong, 0u) << "contact_keep 0.3 is not 0.3 of the compensation pairs' curvature";
 }
 
 TEST(ContactPotentials, FrictionExactNearCorners2D) {
