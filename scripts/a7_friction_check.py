@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """A7 (3D twist): is the friction law or the cube's stiffness behind the slip angle?
 
-    scripts/a7_friction_check.py RUN_DIR MU [--every N]
+    scripts/a7_friction_check.py RUN_DIR[+CONTINUATION_DIR] MU [--every N]
 
 Reads RUN_DIR/bfemp.h5 (h5py) and prints per frame, from the cube's particle
 contact forces f_p (barrier + friction, N) and positions x_p:
@@ -25,14 +25,20 @@ ap.add_argument("run")
 ap.add_argument("mu", type=float)
 ap.add_argument("--every", type=int, default=3)
 a = ap.parse_args()
-f = h5py.File(a.run + "/bfemp.h5", "r")
-frames = sorted(k for k in f.keys() if k.startswith("frame_"))
-x0 = f[frames[0]]["particle_positions"][:]
+# RUN may chain runs as DIR1+DIR2 (a run continued elsewhere, as scripts/h5frames.py):
+# the top centre is chosen in DIR1's first frame, and each later run adds its
+# frames after the last time before it.
+frames = []
+for d in a.run.split("+"):
+    f = h5py.File(d + "/bfemp.h5", "r")
+    last = float(frames[-1].attrs["time"]) if frames else -float("inf")
+    frames += [f[k] for k in sorted(k for k in f.keys() if k.startswith("frame_"))
+               if float(f[k].attrs["time"]) > last + 1e-9]
+x0 = frames[0]["particle_positions"][:]
 top = (np.abs(x0[:, 0]) <= 0.25) & (np.abs(x0[:, 1]) <= 0.25) & (x0[:, 2] >= 0.85)
 ang0 = np.arctan2(x0[top, 1], x0[top, 0])
 print("t_s  cap_pi  top_pi  torque_Nm  capacity_Nm  T/C  T/rot_Nm_per_rad")
-for k in frames[:: a.every]:
-    g = f[k]
+for g in frames[:: a.every]:
     t = float(g.attrs.get("time", 0.0))
     x = g["particle_positions"][:]
     F = g["particle_contact_force"][:]
