@@ -60,11 +60,6 @@ Simulation<dim>::Simulation(SimulationSetup<dim> setup, const Teuchos::RCP<const
     if (setup_.contact && setup_.contact->fem_fem)
       throw std::invalid_argument("Contact/FEM-FEM: true runs on 1 MPI rank in this version; this run has " +
                                   std::to_string(comm->getSize()) + " ranks: run it without mpirun or with -np 1");
-    for (const auto& ls : setup_.level_sets)
-      if (ls.slip)
-        throw std::invalid_argument("level set '" + ls.name + "': 'slip: true' runs on 1 MPI rank in this version "
-                                    "(this run has " + std::to_string(comm->getSize()) +
-                                    " ranks): run it without mpirun or with -np 1, or make it no-slip");
     // Each rank keeps the particles of its box; the grid is shared. FEM
     // bodies: every rank holds the whole mesh and state (its nodes are local
     // everywhere, with their global ids) and assembles the elements Zoltan2

@@ -139,7 +139,6 @@ void DofSpace<dim>::rebuild(const std::string& cause) {
     A_ = Teuchos::rcp(new Matrix(build_dof_graph<dim>(std::as_const(*this).terms(), n_nodes_, map_)));
     A_->fillComplete();
   } else {
-    if (slip_.count() > 0) throw std::invalid_argument("slip constraints run on 1 MPI rank only in this version");
     // Overlap graph (local ids), then the owned graph: each owned row holds the
     // union of its rows on all ranks (built with the value-sum plan).
     auto G_ov = build_dof_graph<dim>(std::as_const(*this).terms(), n_nodes_, overlap_map_, map_);
@@ -251,7 +250,9 @@ void DofSpace<dim>::end_assembly(MaskView prescribed, ConstDofView dx_prescribed
     Kokkos::deep_copy(bv, rhs);
     return;
   }
-  // Sum the overlap matrix and rhs into the owned ones.
+  // The slip transform on this rank's part (Q and w at owned nodes), then
+  // sum the overlap matrix and rhs into the owned ones.
+  slip_.transform_system(A_overlap_->getLocalMatrixDevice(), rhs, owned_mask_);
   A_overlap_->fillComplete(map_, map_, fill_params_);
   Kokkos::Timer timer;
   {

@@ -28,7 +28,9 @@
 // solution comes back to the ghosts with one Import. Constraint rows are
 // written once, on the owned side. The owned nodes may come first (n_owned)
 // or lie anywhere among the local ones (a mask: MPM grid nodes beside a
-// replicated FEM mesh). Slip constraints: 1 rank only (for now).
+// replicated FEM mesh). Slip constraints are built on every local node
+// (ghosts too) and transformed on each rank's overlap part
+// (SlipConstraints::transform_system with the owned mask).
 #include <Teuchos_ParameterList.hpp>
 #include <Tpetra_Export_decl.hpp>
 #include <Tpetra_Import_decl.hpp>

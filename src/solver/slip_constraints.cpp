@@ -141,7 +141,8 @@ double SlipConstraints<dim>::update_offsets(ConstDofView x) {
 }
 
 template <int dim>
-void SlipConstraints<dim>::transform_system(const LocalMatrix& A, DofView rhs) const {
+void SlipConstraints<dim>::transform_system(const LocalMatrix& A, DofView rhs,
+                                            Kokkos::View<const int*, MemSpace> owned) const {
   if (count_ == 0) return;
   auto rows = A.graph.row_map;
   auto cols = A.graph.entries;
@@ -150,6 +151,9 @@ void SlipConstraints<dim>::transform_system(const LocalMatrix& A, DofView rhs) c
   auto Q = Q_;
   auto w = w_;
   const LO n_nodes = static_cast<LO>(rows.extent(0) - 1) / dim;
+  const bool all_owned = owned.extent(0) == 0;
+  if (!all_owned && static_cast<LO>(owned.extent(0)) < n_nodes * dim)
+    throw std::logic_error("SlipConstraints: the owned mask is shorter than the system");
   if (static_cast<LO>(slot.extent(0)) < n_nodes)
     throw std::logic_error("SlipConstraints: the system has more nodes than the constraints were built for");
   if (has_offset_) {  // rhs -= A w (before A is transformed)
@@ -173,6 +177,7 @@ void SlipConstraints<dim>::transform_system(const LocalMatrix& A, DofView rhs) c
         for (int a = 1; a < dim; ++a)
           if (rows(i * dim + a + 1) - rows(i * dim + a) != len) { err = 1 > err ? 1 : err; return; }
         if (len % dim != 0) { err = 1 > err ? 1 : err; return; }
+        const bool own = all_owned || owned(i * dim) != 0;  // Q and w once, at the owner
         Mat<dim> Pi = Mat<dim>::Identity();
         if (si >= 0)
           for (int a = 0; a < dim; ++a)
@@ -192,7 +197,7 @@ void SlipConstraints<dim>::transform_system(const LocalMatrix& A, DofView rhs) c
             for (int a = 0; a < dim; ++a)
               for (int b = 0; b < dim; ++b) Pj(a, b) -= Q(sj, a, b);
           Mat<dim> Bn = Pi * B * Pj;
-          if (i == j)
+          if (i == j && own)
             for (int a = 0; a < dim; ++a)
               for (int b = 0; b < dim; ++b) Bn(a, b) += Q(si, a, b);
           for (int a = 0; a < dim; ++a)
@@ -202,7 +207,7 @@ void SlipConstraints<dim>::transform_system(const LocalMatrix& A, DofView rhs) c
           Vec<dim> r;
           for (int a = 0; a < dim; ++a) r(a) = rhs(i * dim + a);
           const Vec<dim> rn = Pi * r;
-          for (int a = 0; a < dim; ++a) rhs(i * dim + a) = rn(a) + w(si, a);
+          for (int a = 0; a < dim; ++a) rhs(i * dim + a) = rn(a) + (own ? w(si, a) : 0.0);
         }
       },
       Kokkos::Max<int>(bad));

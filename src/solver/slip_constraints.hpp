@@ -43,7 +43,17 @@ class SlipConstraints {
   double update_offsets(ConstDofView x);
   // A <- P A P + Q on the (not yet fill-completed) local matrix, rhs <-
   // P (rhs - A w) + w. The graph must be node-blocked (build_dof_graph).
-  void transform_system(const LocalMatrix& A, DofView rhs) const;
+  // Distributed (owned: 1 at the local DOFs this rank owns, as DofSpace's
+  // owned_mask): A and rhs are this rank's overlap parts, whose sum over the
+  // ranks is the system. P A^r P and P (rhs^r - A^r w) are linear in the
+  // parts, so every rank transforms its own; Q and w are added at owned nodes
+  // only, so that the summed system is the 1-rank one (added by every holder
+  // they would sum to k Q and k w: the same solution, another matrix, and a
+  // CG run that differs from one rank's). The constraints must then cover the
+  // ghost nodes too (build over all local nodes: a node's P, T and w depend
+  // on its x^n, v and x alone, which every rank holding it has alike).
+  void transform_system(const LocalMatrix& A, DofView rhs,
+                        Kokkos::View<const int*, MemSpace> owned = {}) const;
   // p_k <- P_k p_k + w_k at constrained nodes.
   void fix_direction(DofView p) const;
 

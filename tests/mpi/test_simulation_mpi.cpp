@@ -5,8 +5,7 @@
 // block with gravity, in 2D and 3D, with CG + Ifpack2 and CG + MueLu; and
 // every rank reports the same Newton iterations. A one-triangle body, so that
 // on 2 ranks one rank owns no element at all, equals the same on one rank.
-// Slip level sets are refused on more than one rank (MPM bodies, with or
-// without FEM bodies: test_mpm_mpi).
+// (Slip level sets on several ranks: test_mpm_mpi, MovingSlipLevelSet...)
 #include <gtest/gtest.h>
 
 #include <Teuchos_CommHelpers.hpp>
@@ -132,21 +131,4 @@ TEST(SimulationMpi, ARankWithoutElementsEqualsOneRank) {
   EXPECT_LT(s.x[5], 1.0 - 1e-4) << "the top node should have fallen";
   EXPECT_NEAR(d.elastic, s.elastic, 1e-8 * s.elastic);
   expect_same_on_every_rank(*world, d.iterations);
-}
-
-TEST(SimulationMpi, SlipLevelSetRefusedOnSeveralRanks) {
-  auto world = Tpetra::getDefaultComm();
-  if (world->getSize() == 1) GTEST_SKIP() << "needs 2 ranks";
-  auto setup = fixtures::mpm_block_setup(0.4, Vec<2>(0.5, 0.5), 0.1, 4, 0.0, 1.0, TransferScheme::APIC);
-  setup.linear_solver.set("type", std::string("CG"));
-  LevelSet floor;
-  floor.name = "floor";
-  floor.slip = true;
-  setup.level_sets.push_back(floor);
-  try {
-    Simulation<2> sim(setup, world);
-    FAIL() << "a slip level set was accepted on " << world->getSize() << " ranks";
-  } catch (const std::invalid_argument& e) {
-    EXPECT_NE(std::string(e.what()).find("level set 'floor'"), std::string::npos) << e.what();
-  }
 }
