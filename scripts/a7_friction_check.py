@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """A7 (3D twist): is the friction law or the cube's stiffness behind the slip angle?
 
-    scripts/a7_friction_check.py RUN_DIR[+CONTINUATION_DIR] MU [--every N]
+    scripts/a7_friction_check.py RUN_DIR[+CONTINUATION_DIR] MU [--every N] [--zmin Z]
 
 Reads RUN_DIR/bfemp.h5 (h5py) and prints per frame, from the cube's particle
 contact forces f_p (barrier + friction, N) and positions x_p:
@@ -11,7 +11,9 @@ contact forces f_p (barrier + friction, N) and positions x_p:
     sphere's normal) and r_p = |(d_p)_xy| (N m): T/C -> 1 while the whole patch
     slides, if the law delivers mu times the normal force;
   - the rotation of the top centre (particles with |x|,|y| <= 0.25,
-    z >= 0.85 at t = 0; mean angle about z, rad/pi), the cap's prescribed angle
+    z >= Z at t = 0, default 0.95: the top face's particles, as the
+    peak_rotation band of scripts/validate.py; before 2026-12-07 the box went
+    down to 0.85; mean angle about z, rad/pi), the cap's prescribed angle
     (pi/5 rad/s after t = 1 s), and the ratio T/rotation (the cube's torsional
     stiffness seen from the contact while the top sticks, N m/rad).
 """
@@ -24,6 +26,7 @@ ap = argparse.ArgumentParser()
 ap.add_argument("run")
 ap.add_argument("mu", type=float)
 ap.add_argument("--every", type=int, default=3)
+ap.add_argument("--zmin", type=float, default=0.95)
 a = ap.parse_args()
 # RUN may chain runs as DIR1+DIR2 (a run continued elsewhere, as scripts/h5frames.py):
 # the top centre is chosen in DIR1's first frame, and each later run adds its
@@ -35,7 +38,7 @@ for d in a.run.split("+"):
     frames += [f[k] for k in sorted(k for k in f.keys() if k.startswith("frame_"))
                if float(f[k].attrs["time"]) > last + 1e-9]
 x0 = frames[0]["particle_positions"][:]
-top = (np.abs(x0[:, 0]) <= 0.25) & (np.abs(x0[:, 1]) <= 0.25) & (x0[:, 2] >= 0.85)
+top = (np.abs(x0[:, 0]) <= 0.25) & (np.abs(x0[:, 1]) <= 0.25) & (x0[:, 2] >= a.zmin)
 ang0 = np.arctan2(x0[top, 1], x0[top, 0])
 print("t_s  cap_pi  top_pi  torque_Nm  capacity_Nm  T/C  T/rot_Nm_per_rad")
 for g in frames[:: a.every]:

@@ -5,8 +5,10 @@ the twist of the shell's prescribed cap (pi/5 rad/s from t = 1 s).
 
 Reads each run's bfemp.h5 (frames of `bfemp run inputs/a7_twist.yaml -o DIR
 --set Contact/friction=MU`). The top centre: the particles with |x|, |y| <
-0.25 and z > 0.85 at t = 0 (the same set as the `peak_rotation` probe of
-scripts/validate.py). While the cube's top sticks to the shell it turns with
+0.25 and z > 0.95 at t = 0, the top face's particles (the same set as the
+`peak_rotation` band of scripts/validate.py); a thin dotted line of the same
+colour shows the deeper set used before 2026-12-07 (z > 0.85), which turns
+less because the twist falls off with depth under the press. While the cube's top sticks to the shell it turns with
 the cap; where it slips its rotation stops following (the peak is the slip
 angle).
 
@@ -22,10 +24,10 @@ import numpy as np
 from h5frames import parse_args, particle_frames
 
 
-def top_rotation(path):
-    frames = particle_frames(path)
+def top_rotation(path, zmin=0.95, frames=None):
+    frames = frames or particle_frames(path)
     x0 = frames[0][1]
-    top = (np.abs(x0[:, 0]) < 0.25) & (np.abs(x0[:, 1]) < 0.25) & (x0[:, 2] > 0.85)
+    top = (np.abs(x0[:, 0]) < 0.25) & (np.abs(x0[:, 1]) < 0.25) & (x0[:, 2] > zmin)
     top &= np.hypot(x0[:, 0], x0[:, 1]) > 1e-12
     a0 = np.arctan2(x0[top, 1], x0[top, 0])
     t, rot = [], []
@@ -42,11 +44,16 @@ def main():
     fig, ax = plt.subplots(figsize=(6.5, 4.2))
     tmax = 0.0
     for mu, d in runs:
-        t, rot = top_rotation(d)
+        frames = particle_frames(d)
+        t, rot = top_rotation(d, 0.95, frames)
+        _, deep = top_rotation(d, 0.85, frames)
         tmax = max(tmax, t[-1])
         k = int(np.argmax(np.abs(rot)))
-        print(f"mu {mu}: frames to t = {t[-1]:.2f} s; peak rotation {rot[k] / np.pi:.3f} pi at t = {t[k]:.2f} s")
-        ax.plot(t, rot / np.pi, label=f"mu = {mu} (peak {rot[k] / np.pi:.2f} pi)")
+        kd = int(np.argmax(np.abs(deep)))
+        print(f"mu {mu}: frames to t = {t[-1]:.2f} s; peak rotation {rot[k] / np.pi:.3f} pi at t = {t[k]:.2f} s "
+              f"(z0 > 0.85: {deep[kd] / np.pi:.3f} pi at t = {t[kd]:.2f} s)")
+        line, = ax.plot(t, rot / np.pi, label=f"mu = {mu} (peak {rot[k] / np.pi:.2f} pi)")
+        ax.plot(t, deep / np.pi, ":", lw=0.9, color=line.get_color())
     tc = np.linspace(0, max(tmax, 1.0), 200)
     ax.plot(tc, np.clip(tc - 1.0, 0, 4.5) / 5.0, "k--", lw=0.8, label="shell cap twist")
     ax.set_xlabel("t (s)")
