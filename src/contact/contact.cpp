@@ -69,6 +69,40 @@ Contact<dim>::Contact(const FemMesh<dim>& mesh, ContactParams params) : mesh_(me
   Kokkos::deep_copy(fem_point_body_, hb);
 }
 
+template <int dim>
+LO Contact<dim>::fem_point_node(LO k) const {
+  LO n = -1;
+  Kokkos::deep_copy(n, Kokkos::subview(fem_point_node_, k));
+  return n;
+}
+
+template <int dim>
+void Contact<dim>::keep_fem_points(const std::vector<char>& owned) {
+  const LO m = num_fem_points();
+  if (m == 0) return;
+  auto hn = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), fem_point_node_);
+  auto hw = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), fem_point_omega_);
+  auto hb = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), fem_point_body_);
+  LO kept = 0;
+  for (LO k = 0; k < m; ++k) {
+    const LO n = hn(k);
+    if (n < 0 || static_cast<std::size_t>(n) >= owned.size())
+      throw std::logic_error("Contact::keep_fem_points: the owned mask does not cover FEM node " + std::to_string(n));
+    if (!owned[n]) continue;
+    hn(kept) = n;
+    hw(kept) = hw(k);
+    hb(kept) = hb(k);
+    ++kept;
+  }
+  fem_point_node_ = Kokkos::View<LO*, MemSpace>("contact_fem_point_node", kept);
+  fem_point_omega_ = Kokkos::View<double*, MemSpace>("contact_fem_point_omega", kept);
+  fem_point_body_ = Kokkos::View<int*, MemSpace>("contact_fem_point_body", kept);
+  Kokkos::deep_copy(fem_point_node_, Kokkos::subview(hn, std::make_pair(LO(0), kept)));
+  Kokkos::deep_copy(fem_point_omega_, Kokkos::subview(hw, std::make_pair(LO(0), kept)));
+  Kokkos::deep_copy(fem_point_body_, Kokkos::subview(hb, std::make_pair(LO(0), kept)));
+  ps_ = ParticleStencils<dim>{};  // sized again at the next begin_step
+}
+
 namespace {
 // Point q against element e: FEM points (q >= first) skip their own body.
 struct InsideFilter {

@@ -69,6 +69,13 @@ class Contact {
   // FEM-FEM contact: the boundary nodes taking part as contact points (in the
   // order they follow the particles), and their count.
   LO num_fem_points() const { return static_cast<LO>(fem_point_node_.extent(0)); }
+  // The FEM node of contact point np + k (host; for messages).
+  LO fem_point_node(LO k) const;
+  // Several ranks, each holding the whole FEM mesh (MPM + FEM scenes): keep
+  // only the contact points whose node this rank owns (owned[node] != 0), so
+  // that each FEM-FEM pair is evaluated by exactly one rank, as each particle's
+  // pairs are by the rank holding the particle. The facets stay whole.
+  void keep_fem_points(const std::vector<char>& owned);
   const BarrierTerm<dim>* barrier() const { return barrier_.get(); }
   BarrierTerm<dim>* barrier() { return barrier_.get(); }  // (the Newton solver updates its pairs)
   const FrictionTerm<dim>* friction() const { return friction_.get(); }

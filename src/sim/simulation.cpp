@@ -57,9 +57,6 @@ Simulation<dim>::Simulation(SimulationSetup<dim> setup, const Teuchos::RCP<const
   }
   comm_ = comm;
   if (comm->getSize() > 1 && setup_.mpm) {
-    if (setup_.contact && setup_.contact->fem_fem)
-      throw std::invalid_argument("Contact/FEM-FEM: true runs on 1 MPI rank in this version; this run has " +
-                                  std::to_string(comm->getSize()) + " ranks: run it without mpirun or with -np 1");
     // Each rank keeps the particles of its box; the grid is shared. FEM
     // bodies: every rank holds the whole mesh and state (its nodes are local
     // everywhere, with their global ids) and assembles the elements Zoltan2
@@ -152,10 +149,13 @@ Simulation<dim>::Simulation(SimulationSetup<dim> setup, const Teuchos::RCP<const
   Kokkos::deep_copy(prescribed_, pres);
   motions_ = device_motions(setup_.motions);
   if (setup_.contact && (mpm_ || setup_.contact->fem_fem) && mesh_.num_nodes() > 0) {
-    if (distributed_)
-      throw std::invalid_argument("Contact/FEM-FEM: true runs on 1 MPI rank in this version; this run has " +
+    if (distributed_)  // FEM bodies only: each rank holds its piece of the mesh, not the whole boundary
+      throw std::invalid_argument("Contact/FEM-FEM: true in a scene of FEM bodies only runs on 1 MPI rank in this "
+                                  "version (with MPM bodies it runs on any rank count); this run has " +
                                   std::to_string(comm->getSize()) + " ranks: run it without mpirun or with -np 1");
     contact_ = std::make_unique<Contact<dim>>(mesh_, *setup_.contact);
+    // FEM-FEM on several ranks: each FEM contact point on the rank owning its node.
+    if (mpm_distributed_ && contact_->num_fem_points() > 0) contact_->keep_fem_points(fem_owned_);
     // (MPI: each rank checks its particles; all stop with the first failing rank's message.)
     if (mpm_) collective_check(*comm, [&] { contact_->check_initial(mpm_->particles(), x_, mpm_->particle_ids()); });
     else contact_->check_initial_fem(x_);
@@ -163,13 +163,18 @@ Simulation<dim>::Simulation(SimulationSetup<dim> setup, const Teuchos::RCP<const
       newton_->on_iterate = [this](Kokkos::View<const double*, MemSpace> x) {
         const LO q = contact_->particle_inside_at(x);
         const LO np = mpm_ ? static_cast<LO>(mpm_->particles().size()) : 0;
-        if (mpm_distributed_) {  // the highest global id inside, on every rank (no FEM points on several ranks)
-          long long mine = -1, id = -1;
-          if (q >= 0) Kokkos::deep_copy(mine, Kokkos::subview(mpm_->particle_ids(), q));
-          Teuchos::reduceAll(*comm_, Teuchos::REDUCE_MAX, mine, Teuchos::outArg(id));
-          if (id < 0) return;
-          throw SolverError("MPM particle " + std::to_string(id) +
-                            " is inside or on an FEM body at a Newton iterate (Contact/check iterates)");
+        if (mpm_distributed_) {  // the highest global particle id and FEM node inside, on every rank
+          long long mine[2] = {-1, -1}, id[2] = {-1, -1};
+          if (q >= 0 && q < np) Kokkos::deep_copy(mine[0], Kokkos::subview(mpm_->particle_ids(), q));
+          if (q >= np) mine[1] = contact_->fem_point_node(q - np);
+          Teuchos::reduceAll(*comm_, Teuchos::REDUCE_MAX, 2, mine, id);
+          if (id[0] >= 0)
+            throw SolverError("MPM particle " + std::to_string(id[0]) +
+                              " is inside or on an FEM body at a Newton iterate (Contact/check iterates)");
+          if (id[1] >= 0)
+            throw SolverError("FEM boundary node " + std::to_string(id[1]) +
+                              " is inside or on another FEM body at a Newton iterate (Contact/check iterates)");
+          return;
         }
         if (q < 0) return;
         long long id = q;  // sorted particles: name the particle by its id

@@ -17,6 +17,8 @@
 //     blocks, each rank its own (build_setup with a ParticleBlock), and the
 //     blocks then move into the boxes.
 //   - A moving slip level set (the A2 sine press in its level-set form).
+//   - FEM-FEM contact beside an MPM body (the A6 rings).
+//   - The disk-wall impact and the box sliding on the slope with friction.
 // On one rank (np1) the same tests compare the scene with itself through the
 // same code path (distribute() is a no-op), which keeps them meaningful there.
 #include <gtest/gtest.h>
@@ -279,6 +281,29 @@ TEST(MpmMpi, DiskOnMpmFloorWithFrictionEqualsOneRank) {
             << " rank(s): |x - x_alone| = " << ex << " m, |v - v_alone| = " << ev << " m/s\n";
 }
 
+// The disk-wall impact (an MPM rubber disk at 100 m/s into a fixed FEM steel
+// wall: the contact of the first steps, the rebound) and the box on the slope
+// (VALIDATION A4's scene: a stiff MPM box on a tilted-gravity FEM slope, with
+// friction mu 0.1 so that it slides with the lagged friction loop active).
+TEST(MpmMpi, DiskWallImpactEqualsOneRank) {
+  auto world = Tpetra::getDefaultComm();
+  Teuchos::RCP<const Comm> self = Teuchos::rcp(new Teuchos::MpiComm<int>(MPI_COMM_SELF));
+  const std::vector<std::string> o = {"Newton/eps_d=1e-9"};
+  const SceneResult d = run_scene_steps("contact_disk_wall.yaml", o, world, 20);
+  const SceneResult s = run_scene_steps("contact_disk_wall.yaml", o, self, 20);
+  compare_scenes(*world, d, s, 1e-9, 1e-6, "disk-wall impact");
+}
+
+TEST(MpmMpi, BoxSlidingOnTheSlopeWithFrictionEqualsOneRank) {
+  auto world = Tpetra::getDefaultComm();
+  Teuchos::RCP<const Comm> self = Teuchos::rcp(new Teuchos::MpiComm<int>(MPI_COMM_SELF));
+  const std::vector<std::string> o = {"Time/end time=0.04", "Contact/friction=0.1",
+                                      "Contact/friction pass tolerance=1"};
+  const SceneResult d = run_scene_steps("contact_slope.yaml", o, world, 40);
+  const SceneResult s = run_scene_steps("contact_slope.yaml", o, self, 40);
+  compare_scenes(*world, d, s, 1e-9, 1e-6, "box on the slope, mu 0.1");
+}
+
 // A moving slip level set (VALIDATION A2's sine press, level-set form): the
 // sine boundary presses the box down for 0.04 s, then drags left, as an exact
 // constraint on the grid nodes inside it (n . v = the boundary's, tangent
@@ -304,6 +329,32 @@ TEST(MpmMpi, MovingSlipLevelSetEqualsOneRank) {
   EXPECT_LT(mean_y, 0.25 - 1e-3) << "the slip boundary did not press the box";
   std::cout << "sine press (slip level set), " << world->getSize() << " rank(s): particles' mean y = " << mean_y
             << " m (0.25 at the start)\n";
+}
+
+// FEM-FEM contact beside MPM bodies (VALIDATION A6 at the ci size: an FEM
+// plate pressing an FEM outer ring with mu 10, FEM-FEM, which presses the MPM
+// inner ring through MPM-FEM contact, with mu 0.2 between the rings, and a
+// slip box under the middle). Each FEM contact point lives on the rank owning
+// its node (Contact::keep_fem_points), each particle on its slab's rank: every
+// pair once. 60 steps (0.6 m of plate travel): the plate-ring pairs from the
+// first steps, the ring-ring pairs once the 0.01 m gap has closed.
+TEST(MpmMpi, FemFemContactBesideMpmEqualsOneRank) {
+  auto world = Tpetra::getDefaultComm();
+  Teuchos::RCP<const Comm> self = Teuchos::rcp(new Teuchos::MpiComm<int>(MPI_COMM_SELF));
+  const std::vector<std::string> o = {"Time/end time=0.6", "Newton/eps_d=1e-9",
+                                      "Contact/Friction Pairs/inner : outer=0.2",
+                                      "Contact/friction pass tolerance=1"};
+  const SceneResult d = run_scene_steps("a6_semiring_buckling.yaml", o, world, 60);
+  const SceneResult s = run_scene_steps("a6_semiring_buckling.yaml", o, self, 60);
+  compare_scenes(*world, d, s, 1e-8, 1e-6, "A6 rings (FEM-FEM + MPM-FEM)");
+  // The plate presses the outer ring into the inner one: the MPM ring's
+  // crown has moved down by then.
+  if (world->getRank() != 0) return;
+  double top = 0;
+  for (std::size_t i = 0; i + 1 < d.r.x.size(); i += 2)
+    if (std::abs(d.r.x[i]) < 1.0) top = std::max(top, d.r.x[i + 1]);
+  EXPECT_LT(top, 11.99 - 0.1) << "the inner ring's crown did not move down: no ring-ring contact";
+  std::cout << "A6 rings, " << world->getSize() << " rank(s): the inner ring's crown top at y = " << top << " m\n";
 }
 
 // A particle starting inside the FEM ring is found by the rank holding it;

@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # The bfemp executable on 1 and 2 MPI ranks (label mpi): the squash scene
 # (FEM only, CG) gives the same frames and diagnostics on both; on 2 ranks a
-# direct solver, FEM-FEM contact and an explicit scene are refused before the
+# direct solver, FEM-FEM contact without MPM bodies and an explicit scene are refused before the
 # first step (exit 2, a message naming the key), as are particles starting outside the grid or
 # inside a level set's solid, found in one rank's sampled block or in both (the message 1 rank gives); a 2-rank run restarted on 2 ranks equals the
 # uninterrupted one bit for bit. The MPM column (MPM alone: particles in slabs) gives the same
@@ -78,10 +78,33 @@ set +e
 set -e
 [ $rc = 2 ] && grep -q "Linear Solver/type" "$work/direct.log" || { echo "direct solver on 2 ranks: exit $rc"; cat "$work/direct.log"; exit 1; }
 [ ! -e "$work/direct/bfemp.h5" ] || { echo "the refused run wrote output"; exit 1; }
+# FEM-FEM contact in a scene of FEM bodies only (beside MPM bodies it runs:
+# test_mpm_mpi's FemFemContactBesideMpmEqualsOneRank).
+cat > "$work/fem_fem.yaml" <<'YAML'
+bfemp:
+  dimension: 2
+  gravity: [0.0, -10.0]
+  Time: {dt: 1.0e-2, end time: 0.05, integrator: backward-euler}
+  Materials:
+    soft: {E: 1.0e5, nu: 0.3, density: 1000.0}
+  FEM Bodies:
+    lower:
+      material: soft
+      Mesh: {shape: rectangle, center: [0.0, 0.0], size: [1.0, 0.2], element size: 0.1}
+      Boundary Conditions:
+        base: {box min: [-1.0, -0.2], box max: [1.0, -0.09]}
+    upper:
+      material: soft
+      Mesh: {shape: rectangle, center: [0.0, 0.2], size: [0.4, 0.1], element size: 0.1}
+  Contact: {dhat: 1.0e-3, kappa: 1.0e5, FEM-FEM: true}
+  Linear Solver: {type: CG}
+YAML
 set +e
-"${mpi[@]}" -np 2 "$exe" run "$src/inputs/a6_semiring_buckling.yaml" --output "$work/fem_fem" --set 'Linear Solver/type=CG' > "$work/fem_fem.log" 2>&1; rc=$?
+"${mpi[@]}" -np 2 "$exe" run "$work/fem_fem.yaml" --output "$work/fem_fem" > "$work/fem_fem.log" 2>&1; rc=$?
 set -e
-[ $rc = 2 ] && grep -q "Contact/FEM-FEM" "$work/fem_fem.log" || { echo "FEM-FEM contact on 2 ranks: exit $rc"; cat "$work/fem_fem.log"; exit 1; }
+[ $rc = 2 ] && grep -q "Contact/FEM-FEM" "$work/fem_fem.log" && grep -q "FEM bodies only" "$work/fem_fem.log" \
+  || { echo "FEM-FEM contact without MPM bodies on 2 ranks: exit $rc"; cat "$work/fem_fem.log"; exit 1; }
+[ ! -e "$work/fem_fem/bfemp.h5" ] || { echo "the refused FEM-FEM run wrote output"; exit 1; }
 set +e
 "${mpi[@]}" -np 2 "$exe" run "$src/inputs/b1_contact.yaml" --output "$work/explicit" > "$work/explicit.log" 2>&1; rc=$?
 set -e
