@@ -179,8 +179,10 @@ Simulation<dim>::Simulation(SimulationSetup<dim> setup, const Teuchos::RCP<const
         if (q < 0) return;
         long long id = q;  // sorted particles: name the particle by its id
         if (q < np && !mpm_->particles_in_id_order()) Kokkos::deep_copy(id, Kokkos::subview(mpm_->particle_ids(), q));
-        throw SolverError((q < np ? "MPM particle " + std::to_string(id)
-                                  : "FEM boundary node (contact point " + std::to_string(q - np) + ")") +
+        if (q >= np)  // named as on several ranks: by its mesh node
+          throw SolverError("FEM boundary node " + std::to_string(contact_->fem_point_node(q - np)) +
+                            " is inside or on another FEM body at a Newton iterate (Contact/check iterates)");
+        throw SolverError("MPM particle " + std::to_string(id) +
                           " is inside or on an FEM body at a Newton iterate (Contact/check iterates)");
       };
   }

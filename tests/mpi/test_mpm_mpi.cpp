@@ -282,9 +282,10 @@ TEST(MpmMpi, DiskOnMpmFloorWithFrictionEqualsOneRank) {
 }
 
 // The disk-wall impact (an MPM rubber disk at 100 m/s into a fixed FEM steel
-// wall: the contact of the first steps, the rebound) and the box on the slope
-// (VALIDATION A4's scene: a stiff MPM box on a tilted-gravity FEM slope, with
-// friction mu 0.1 so that it slides with the lagged friction loop active).
+// wall: 8 of the 20 steps in contact) and the box on the slope (VALIDATION
+// A4's scene: a stiff MPM box on a tilted-gravity FEM slope, with friction
+// mu 0.1, below the critical 0.2, so that the lagged friction loop runs on
+// every step in contact).
 TEST(MpmMpi, DiskWallImpactEqualsOneRank) {
   auto world = Tpetra::getDefaultComm();
   Teuchos::RCP<const Comm> self = Teuchos::rcp(new Teuchos::MpiComm<int>(MPI_COMM_SELF));
@@ -310,7 +311,7 @@ TEST(MpmMpi, BoxSlidingOnTheSlopeWithFrictionEqualsOneRank) {
 // free; SlipConstraints). On 2 ranks each rank builds the constraints of its
 // owned and ghost nodes and transforms its overlap part of the system; the
 // run equals one rank alone. Checked to mean something: the press moves the
-// box's top down.
+// box down (its particles' mean height falls; nothing else moves it).
 TEST(MpmMpi, MovingSlipLevelSetEqualsOneRank) {
   auto world = Tpetra::getDefaultComm();
   Teuchos::RCP<const Comm> self = Teuchos::rcp(new Teuchos::MpiComm<int>(MPI_COMM_SELF));

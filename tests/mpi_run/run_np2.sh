@@ -11,7 +11,8 @@
 # checkpoint (each rank wrote its row block, MPI-IO) restarted on 1 and on 3 ranks, and on 2
 # with its row blocks removed (the older format, read whole). The colliding
 # rings (MPM + FEM, barrier contact) write the same frames on 1 and 2 ranks, the particles'
-# contact forces included (in scene order). The 3D twist (A7, coarsened, shortened)
+# contact forces included (in scene order), as do the A6 rings (FEM-FEM contact
+# and a slip level set beside MPM-FEM contact). The 3D twist (A7, coarsened, shortened)
 # with friction on 2 ranks (CG + BLOCK_CHOLMOD) equals 1 rank (Cholmod): the cube is cut at x = 0 under the
 # shell, so contact pairs and their lagged friction live on both ranks. Usage: run_np2.sh BFEMP SOURCE_DIR WORK_DIR
 set -euo pipefail
@@ -229,6 +230,28 @@ with h5py.File(a + "/bfemp.h5", "r") as fa, h5py.File(b + "/bfemp.h5", "r") as f
         err = np.abs(va - vb).max() / np.abs(va).max()
         assert err < 1e-8, f"{f}/{d}: relative difference {err}"
 print("rings (MPM + FEM contact): 1 and 2 ranks write the same frames, contact forces included")
+PY
+# The A6 rings (MPM inner ring, FEM outer ring and plate: FEM-FEM contact
+# beside MPM-FEM contact, and a slip level set under the middle), 30 steps:
+# 1 and 2 ranks write the same frames, the particles' contact forces included.
+a6=(--set 'Time/end time=0.3' --set 'Linear Solver/type=CG' --set 'Linear Solver/CG/tolerance=1e-13'
+    --set 'Newton/eps_d=1e-9' --set 'Output/frame every=10')
+"${mpi[@]}" -np 1 "$exe" run "$src/inputs/a6_semiring_buckling.yaml" --output "$work/a6_1" "${a6[@]}" > "$work/a6_1.log" 2>&1
+"${mpi[@]}" -np 2 "$exe" run "$src/inputs/a6_semiring_buckling.yaml" --output "$work/a6_2" "${a6[@]}" > "$work/a6_2.log" 2>&1 \
+  || { echo "A6 (FEM-FEM + slip level set) on 2 ranks failed"; cat "$work/a6_2.log"; exit 1; }
+/usr/bin/python3 - "$work/a6_1" "$work/a6_2" <<'PY'
+import sys, h5py, numpy as np
+a, b = sys.argv[1:3]
+with h5py.File(a + "/bfemp.h5", "r") as fa, h5py.File(b + "/bfemp.h5", "r") as fb:
+    fr = sorted(k for k in fa if k.startswith("frame_"))
+    assert fr == sorted(k for k in fb if k.startswith("frame_")) and len(fr) == 4, fr
+    for f in fr[1:]:
+        assert np.abs(fa[f]["particle_contact_force"][()]).max() > 0, f"{f}: no contact force on the MPM ring"
+        for d in ("positions", "velocities", "particle_positions", "particle_velocities", "particle_contact_force"):
+            va, vb = fa[f][d][()], fb[f][d][()]
+            err = np.abs(va - vb).max() / np.abs(va).max()
+            assert err < 1e-8, f"{f}/{d}: relative difference {err}"
+print("A6 rings (FEM-FEM + MPM-FEM contact, slip level set): 1 and 2 ranks write the same frames")
 PY
 # The 3D twist (A7) with friction mu 0.5, coarsened (dx 0.25: 512 particles; shell element
 # size 0.2), the shell lowered to 1.25 cm above the particles and the schedule shortened
