@@ -71,7 +71,7 @@ class Contact {
   LO num_fem_points() const { return static_cast<LO>(fem_point_node_.extent(0)); }
   // The FEM node of contact point np + k (host; for messages).
   LO fem_point_node(LO k) const;
-  // Several ranks, each holding the whole FEM mesh (MPM + FEM scenes): keep
+  // Several ranks, each holding the whole FEM mesh (Simulation's fem_shared_): keep
   // only the contact points whose node this rank owns (owned[node] != 0), so
   // that each FEM-FEM pair is evaluated by exactly one rank, as each particle's
   // pairs are by the rank holding the particle. The facets stay whole.

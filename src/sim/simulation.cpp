@@ -63,25 +63,24 @@ Simulation<dim>::Simulation(SimulationSetup<dim> setup, const Teuchos::RCP<const
     // gives it; a node is owned by the lowest rank with an element on it.
     mpm_->distribute(comm, mesh_.num_nodes());
     mpm_distributed_ = true;
-    if (mesh_.num_nodes() > 0) {
-      part_ = partition_fem_mesh<dim>(mesh_, comm);
-      FemPartition global_ids = part_;
-      global_ids.nodes.resize(mesh_.num_nodes());
-      for (LO v = 0; v < mesh_.num_nodes(); ++v) global_ids.nodes[v] = v;
-      local_elasticity_ =
-          std::make_unique<DeformationTerm<dim, dim + 1>>("fem elasticity", local_fem_mesh<dim>(mesh_, global_ids).elements);
-      if (!part_.elements.empty())
-        local_elasticity_->set_coloring(color_stencils<dim + 1>(local_elasticity_->stencils().nodes, mesh_.num_nodes()));
-      fem_owned_.assign(mesh_.num_nodes(), 0);
-      for (LO a = 0; a < part_.n_owned; ++a) fem_owned_[part_.nodes[a]] = 1;
-    }
+    if (mesh_.num_nodes() > 0) share_fem_mesh(comm);
     double m = mpm_min_particle_mass_;
     Teuchos::reduceAll(*comm, Teuchos::REDUCE_MIN, m, Teuchos::outArg(mpm_min_particle_mass_));
   }
   if (!std::isfinite(mpm_min_particle_mass_)) mpm_min_particle_mass_ = 0.0;
   newton_ = std::make_unique<NewtonSolver<dim>>(comm, setup_.linear_solver, setup_.newton);
   sys_ = std::make_unique<System>();
-  if (comm->getSize() > 1 && !setup_.mpm) {
+  const bool fem_fem = setup_.contact && setup_.contact->fem_fem;
+  if (comm->getSize() > 1 && !setup_.mpm && fem_fem) {
+    // FEM only, with FEM-FEM contact: every rank holds the whole mesh (the
+    // contact pairs need the whole boundary), assembles its elements and
+    // evaluates the pairs of the boundary nodes it owns.
+    share_fem_mesh(comm);
+    std::vector<GO> ids(static_cast<std::size_t>(mesh_.num_nodes()));
+    for (LO v = 0; v < mesh_.num_nodes(); ++v) ids[v] = v;
+    newton_->set_partition(std::move(ids), fem_owned_);
+    newton_->set_system(mesh_.num_nodes(), {local_elasticity_.get()});
+  } else if (comm->getSize() > 1 && !setup_.mpm) {
     // FEM only: cut the elements into the ranks; Newton runs on this rank's piece.
     distributed_ = true;
     part_ = partition_fem_mesh<dim>(mesh_, comm);
@@ -107,7 +106,7 @@ Simulation<dim>::Simulation(SimulationSetup<dim> setup, const Teuchos::RCP<const
     throw std::invalid_argument("scene has " + std::to_string(setup_.level_sets.size()) +
                                 " level sets; expected at most " + std::to_string(kMaxLevelSets));
   for (const auto& ls : setup_.level_sets) level_sets_.sets[level_sets_.count++] = ls;
-  if (!mpm_ && !distributed_) newton_->set_system(mesh_.num_nodes(), {elasticity_.get()});
+  if (!mpm_ && !distributed_ && !fem_shared_) newton_->set_system(mesh_.num_nodes(), {elasticity_.get()});
   const std::size_t n = static_cast<std::size_t>(mesh_.num_nodes()) * dim;
   x_ = View1("fem_x", n);
   v_ = View1("fem_v", n);
@@ -149,13 +148,9 @@ Simulation<dim>::Simulation(SimulationSetup<dim> setup, const Teuchos::RCP<const
   Kokkos::deep_copy(prescribed_, pres);
   motions_ = device_motions(setup_.motions);
   if (setup_.contact && (mpm_ || setup_.contact->fem_fem) && mesh_.num_nodes() > 0) {
-    if (distributed_)  // FEM bodies only: each rank holds its piece of the mesh, not the whole boundary
-      throw std::invalid_argument("Contact/FEM-FEM: true in a scene of FEM bodies only runs on 1 MPI rank in this "
-                                  "version (with MPM bodies it runs on any rank count); this run has " +
-                                  std::to_string(comm->getSize()) + " ranks: run it without mpirun or with -np 1");
     contact_ = std::make_unique<Contact<dim>>(mesh_, *setup_.contact);
     // FEM-FEM on several ranks: each FEM contact point on the rank owning its node.
-    if (mpm_distributed_ && contact_->num_fem_points() > 0) contact_->keep_fem_points(fem_owned_);
+    if (fem_shared_ && contact_->num_fem_points() > 0) contact_->keep_fem_points(fem_owned_);
     // (MPI: each rank checks its particles; all stop with the first failing rank's message.)
     if (mpm_) collective_check(*comm, [&] { contact_->check_initial(mpm_->particles(), x_, mpm_->particle_ids()); });
     else contact_->check_initial_fem(x_);
@@ -163,7 +158,7 @@ Simulation<dim>::Simulation(SimulationSetup<dim> setup, const Teuchos::RCP<const
       newton_->on_iterate = [this](Kokkos::View<const double*, MemSpace> x) {
         const LO q = contact_->particle_inside_at(x);
         const LO np = mpm_ ? static_cast<LO>(mpm_->particles().size()) : 0;
-        if (mpm_distributed_) {  // the highest global particle id and FEM node inside, on every rank
+        if (mpm_distributed_ || fem_shared_) {  // the highest global particle id and FEM node inside, on every rank
           long long mine[2] = {-1, -1}, id[2] = {-1, -1};
           if (q >= 0 && q < np) Kokkos::deep_copy(mine[0], Kokkos::subview(mpm_->particle_ids(), q));
           if (q >= np) mine[1] = contact_->fem_point_node(q - np);
@@ -189,6 +184,24 @@ Simulation<dim>::Simulation(SimulationSetup<dim> setup, const Teuchos::RCP<const
   reset_acceleration();
 }
 
+// Several ranks, the whole FEM mesh on each: Zoltan2 RCB of the elements;
+// this rank's elements with global node ids; a node is owned by the lowest
+// rank with an element on it.
+template <int dim>
+void Simulation<dim>::share_fem_mesh(const Teuchos::RCP<const Comm>& comm) {
+  part_ = partition_fem_mesh<dim>(mesh_, comm);
+  FemPartition global_ids = part_;
+  global_ids.nodes.resize(mesh_.num_nodes());
+  for (LO v = 0; v < mesh_.num_nodes(); ++v) global_ids.nodes[v] = v;
+  local_elasticity_ =
+      std::make_unique<DeformationTerm<dim, dim + 1>>("fem elasticity", local_fem_mesh<dim>(mesh_, global_ids).elements);
+  if (!part_.elements.empty())
+    local_elasticity_->set_coloring(color_stencils<dim + 1>(local_elasticity_->stencils().nodes, mesh_.num_nodes()));
+  fem_owned_.assign(mesh_.num_nodes(), 0);
+  for (LO a = 0; a < part_.n_owned; ++a) fem_owned_[part_.nodes[a]] = 1;
+  fem_shared_ = true;
+}
+
 template <int dim>
 Simulation<dim>::~Simulation() = default;
 
@@ -210,7 +223,8 @@ void Simulation<dim>::reset_acceleration() {
   auto m = mass_;
   auto pres = prescribed_;
   Kokkos::deep_copy(a, 0.0);
-  if (distributed_) elasticity_->gradient(x_, -1.0, a);  // the replicated whole mesh (Newton's term is local)
+  if (distributed_ || (fem_shared_ && !mpm_))
+    elasticity_->gradient(x_, -1.0, a);  // the replicated whole mesh (Newton's term is local)
   else newton_->potential_gradient(x_, -1.0, a);
   const auto g = setup_.gravity;
   Kokkos::parallel_for(
@@ -341,7 +355,7 @@ StepReport Simulation<dim>::step() {
   Kokkos::deep_copy(Kokkos::subview(pres, fem), prescribed_);
   std::vector<EnergyTerm<dim>*> terms;
   bool graph_rebuilt = false;
-  if (nF > 0) terms.push_back(mpm_distributed_ ? local_elasticity_.get() : elasticity_.get());
+  if (nF > 0) terms.push_back(fem_shared_ ? local_elasticity_.get() : elasticity_.get());
   if (mpm_) {
     auto grid_part = std::make_pair(nfd, nd);
     Kokkos::deep_copy(Kokkos::subview(pres, grid_part), 0);
@@ -424,7 +438,7 @@ StepReport Simulation<dim>::step() {
   // of 4e-3). A step that fails so is redone from its start with the
   // projected Hessian, which converges there.
   const bool can_retry = newton_->hessian_mode() == HessianMode::ExactIfDefinite &&
-                         newton_->linear_solver().kind() == LinearSolverKind::Cholmod && !distributed_ &&
+                         newton_->linear_solver().kind() == LinearSolverKind::Cholmod && !distributed_ && !fem_shared_ &&
                          !mpm_distributed_;
   auto x_start = System::head(S.x_start, nd);
   if (can_retry) Kokkos::deep_copy(x_start, x);
@@ -462,7 +476,7 @@ StepReport Simulation<dim>::step() {
   if (graph_rebuilt) ++ns.graph_builds;
   typename Contact<dim>::Report contact_report;
   if (contact_) contact_report = contact_->report(x, nF);
-  if (contact_ && mpm_distributed_) reduce_report(contact_report);
+  if (contact_ && (mpm_distributed_ || fem_shared_)) reduce_report(contact_report);
   if (contact_ && mpm_ && !mpm_->particles_in_id_order()) {
     // The particle contact forces follow this step's particle order, which
     // migration below (and the next step's sort) changes: keep their ids
@@ -607,7 +621,7 @@ NewtonStats Simulation<dim>::minimize_with_friction(const IncrementalPotential& 
   const int cap = contact_->friction_max_iterations();
   auto update = [&] {  // pairs with friction, over all ranks
     LO n = contact_->update_friction(x, x_ref, s, ip.dt);
-    if (mpm_distributed_) {
+    if (mpm_distributed_ || fem_shared_) {
       const LO mine = n;
       Teuchos::reduceAll(*comm_, Teuchos::REDUCE_SUM, mine, Teuchos::outArg(n));
     }

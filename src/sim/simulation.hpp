@@ -132,7 +132,7 @@ class Simulation {
   // Newton step runs on (nullptr on 1 rank). The FEM state (positions,
   // velocities, the mesh) stays replicated on every rank in this version;
   // each rank assembles and solves only its piece.
-  const FemPartition* partition() const { return distributed_ ? &part_ : nullptr; }
+  const FemPartition* partition() const { return distributed_ || fem_shared_ ? &part_ : nullptr; }
   MpmBodies<dim>* mpm() { return mpm_.get(); }
   const MpmBodies<dim>* mpm() const { return mpm_.get(); }
   NewtonSolver<dim>& newton() { return *newton_; }
@@ -187,11 +187,17 @@ class Simulation {
   // MPI: the partition, this rank's elasticity (local node ids), the global
   // DOF of each local DOF, and the local copies of the step's inputs.
   Teuchos::RCP<const Comm> comm_;
-  bool distributed_ = false;      // FEM bodies only, elements cut into the ranks
+  bool distributed_ = false;      // FEM bodies only (no FEM-FEM contact), elements cut into the ranks
   bool mpm_distributed_ = false;  // MPM bodies only, particles cut into boxes (MpmBodies::distribute)
+  // Several ranks, each holding the whole FEM mesh and state, assembling the
+  // elements Zoltan2 gives it (local_elasticity_) and owning fem_owned_: MPM +
+  // FEM scenes, and FEM-only scenes with FEM-FEM contact (whose pairs need the
+  // whole boundary on every rank).
+  bool fem_shared_ = false;
+  void share_fem_mesh(const Teuchos::RCP<const Comm>& comm);
   FemPartition part_;
   std::unique_ptr<DeformationTerm<dim, dim + 1>> local_elasticity_;  // MPM + FEM: this rank's elements, global node ids
-  std::vector<char> fem_owned_;                   // MPM + FEM on several ranks: FEM nodes owned here
+  std::vector<char> fem_owned_;                   // fem_shared_: the FEM nodes owned here
   Kokkos::View<long long*, MemSpace> force_ids_;  // contact_force_ids()
   bool contact_reported_ = false;
   Kokkos::View<LO*, MemSpace> local_dof_;

@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # The bfemp executable on 1 and 2 MPI ranks (label mpi): the squash scene
 # (FEM only, CG) gives the same frames and diagnostics on both; on 2 ranks a
-# direct solver, FEM-FEM contact without MPM bodies and an explicit scene are refused before the
+# direct solver and an explicit scene are refused before the
 # first step (exit 2, a message naming the key), as are particles starting outside the grid or
 # inside a level set's solid, found in one rank's sampled block or in both (the message 1 rank gives); a 2-rank run restarted on 2 ranks equals the
 # uninterrupted one bit for bit. The MPM column (MPM alone: particles in slabs) gives the same
@@ -12,7 +12,8 @@
 # with its row blocks removed (the older format, read whole). The colliding
 # rings (MPM + FEM, barrier contact) write the same frames on 1 and 2 ranks, the particles'
 # contact forces included (in scene order), as do the A6 rings (FEM-FEM contact
-# and a slip level set beside MPM-FEM contact). The 3D twist (A7, coarsened, shortened)
+# and a slip level set beside MPM-FEM contact) and two FEM blocks in FEM-FEM
+# contact (FEM bodies only). The 3D twist (A7, coarsened, shortened)
 # with friction on 2 ranks (CG + BLOCK_CHOLMOD) equals 1 rank (Cholmod): the cube is cut at x = 0 under the
 # shell, so contact pairs and their lagged friction live on both ranks. Usage: run_np2.sh BFEMP SOURCE_DIR WORK_DIR
 set -euo pipefail
@@ -79,13 +80,16 @@ set +e
 set -e
 [ $rc = 2 ] && grep -q "Linear Solver/type" "$work/direct.log" || { echo "direct solver on 2 ranks: exit $rc"; cat "$work/direct.log"; exit 1; }
 [ ! -e "$work/direct/bfemp.h5" ] || { echo "the refused run wrote output"; exit 1; }
-# FEM-FEM contact in a scene of FEM bodies only (beside MPM bodies it runs:
-# test_mpm_mpi's FemFemContactBesideMpmEqualsOneRank).
+# FEM-FEM contact in a scene of FEM bodies only: a block dropped on a held
+# one under gravity (every rank holds the whole mesh and evaluates the pairs of
+# the boundary nodes it owns). 1 and 2 ranks write the same frames.
 cat > "$work/fem_fem.yaml" <<'YAML'
 bfemp:
   dimension: 2
   gravity: [0.0, -10.0]
-  Time: {dt: 1.0e-2, end time: 0.05, integrator: backward-euler}
+  Time: {dt: 1.0e-2, end time: 0.2, integrator: backward-euler}
+  Newton: {eps_d: 1.0e-9}
+  Output: {frame every: 10}
   Materials:
     soft: {E: 1.0e5, nu: 0.3, density: 1000.0}
   FEM Bodies:
@@ -96,16 +100,35 @@ bfemp:
         base: {box min: [-1.0, -0.2], box max: [1.0, -0.09]}
     upper:
       material: soft
-      Mesh: {shape: rectangle, center: [0.0, 0.2], size: [0.4, 0.1], element size: 0.1}
-  Contact: {dhat: 1.0e-3, kappa: 1.0e5, FEM-FEM: true}
-  Linear Solver: {type: CG}
+      Mesh: {shape: rectangle, center: [0.05, 0.152], size: [0.4, 0.1], element size: 0.1}
+  Contact: {dhat: 1.0e-3, kappa: 1.0e5, FEM-FEM: true, friction: 0.3, force body: lower}
+  Linear Solver: {type: CG, CG: {tolerance: 1.0e-13}}
 YAML
-set +e
-"${mpi[@]}" -np 2 "$exe" run "$work/fem_fem.yaml" --output "$work/fem_fem" > "$work/fem_fem.log" 2>&1; rc=$?
-set -e
-[ $rc = 2 ] && grep -q "Contact/FEM-FEM" "$work/fem_fem.log" && grep -q "FEM bodies only" "$work/fem_fem.log" \
-  || { echo "FEM-FEM contact without MPM bodies on 2 ranks: exit $rc"; cat "$work/fem_fem.log"; exit 1; }
-[ ! -e "$work/fem_fem/bfemp.h5" ] || { echo "the refused FEM-FEM run wrote output"; exit 1; }
+"${mpi[@]}" -np 1 "$exe" run "$work/fem_fem.yaml" --output "$work/fem_fem1" > "$work/fem_fem1.log" 2>&1
+"${mpi[@]}" -np 2 "$exe" run "$work/fem_fem.yaml" --output "$work/fem_fem2" > "$work/fem_fem2.log" 2>&1 \
+  || { echo "FEM-FEM contact (FEM bodies only) on 2 ranks failed"; cat "$work/fem_fem2.log"; exit 1; }
+/usr/bin/python3 - "$work/fem_fem1" "$work/fem_fem2" <<'PY'
+import sys, csv, h5py, numpy as np
+a, b = sys.argv[1:3]
+with h5py.File(a + "/bfemp.h5", "r") as fa, h5py.File(b + "/bfemp.h5", "r") as fb:
+    fr = sorted(k for k in fa if k.startswith("frame_"))
+    assert fr == sorted(k for k in fb if k.startswith("frame_")) and len(fr) == 3, fr
+    for f in fr[1:]:
+        for d in ("positions", "velocities"):
+            va, vb = fa[f][d][()], fb[f][d][()]
+            err = np.abs(va - vb).max() / np.abs(va).max()
+            assert err < 1e-8, f"{f}/{d}: relative difference {err}"
+ra = list(csv.DictReader(open(a + "/diagnostics.csv")))
+rb = list(csv.DictReader(open(b + "/diagnostics.csv")))
+touching = sum(int(r["contact_pairs"]) > 0 for r in ra)
+assert touching >= 5, f"the upper block touched the lower one in {touching} steps: the check checks no contact"
+for x, y in zip(ra, rb):
+    assert x["contact_pairs"] == y["contact_pairs"], (x["step"], x["contact_pairs"], y["contact_pairs"])
+    u, v = float(x["contact_force_y"]), float(y["contact_force_y"])  # on the lower block
+    assert abs(u - v) <= 1e-6 * max(abs(u), 1.0), (x["step"], u, v)
+assert abs(float(ra[-1]["contact_force_y"])) > 100, "no contact force on the lower block"  # (the upper's weight: 400 N/m)
+print(f"FEM-FEM contact, FEM bodies only: 1 and 2 ranks write the same frames ({touching} steps in contact)")
+PY
 set +e
 "${mpi[@]}" -np 2 "$exe" run "$src/inputs/b1_contact.yaml" --output "$work/explicit" > "$work/explicit.log" 2>&1; rc=$?
 set -e
@@ -118,7 +141,7 @@ set -e
 [ $rc = 2 ] && grep -q "'MPM/boxes per axis' = \[1, 1\]" "$work/boxes.log" && grep -q "number of ranks, 2" "$work/boxes.log" \
   || { echo "boxes for 1 rank on 2 ranks: exit $rc"; cat "$work/boxes.log"; exit 1; }
 [ ! -e "$work/boxes/bfemp.h5" ] || { echo "the refused boxes run wrote output"; exit 1; }
-echo "refusals on 2 ranks: direct solver, FEM-FEM contact, explicit scene, boxes for another rank count (exit 2)"
+echo "refusals on 2 ranks: direct solver, explicit scene, boxes for another rank count (exit 2)"
 # Each rank samples its id block of the particles and checks only those: a
 # bad start found on one rank (the column's top, rank 1's block, above the
 # grid) or on both (the ground raised into the column) stops both ranks with
