@@ -174,6 +174,9 @@ TEST(MpmMpi, CubeOnATiltedSlipPlaneAcrossTheCutEqualsOneRank3D) {
   compare<3>(*world, d, s, 1e-9, "3D cube on a slip plane");
   EXPECT_GT(total, 0) << "no grid node under the slip plane: the test tests nothing of it";
   EXPECT_GT(alone.newton().slip_constraints().count(), 0);
+  // Owned plus ghost copies: more than one rank's count once some constrained
+  // node is held by two ranks (the cut runs through the constrained layer).
+  if (world->getSize() > 1) EXPECT_GT(total, static_cast<int>(alone.newton().slip_constraints().count()));
   if (world->getSize() > 1) EXPECT_GT(d.migrated, 0);
 }
 
@@ -184,6 +187,7 @@ struct SceneResult {
   std::vector<double> fem_x;
   std::vector<long> pairs;
   std::vector<std::array<double, 3>> force;
+  int fem_points = 0;  // this rank's FEM-FEM contact points
 };
 
 SceneResult run_scene_steps(const std::string& file, const std::vector<std::string>& overrides,
@@ -213,6 +217,7 @@ SceneResult run_scene_steps(const std::string& file, const std::vector<std::stri
   auto fx = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), sim.positions());
   out.fem_x.assign(fx.data(), fx.data() + fx.size());
   out.r.migrated = sim.mpm()->migrated_particles();
+  if (sim.contact()) out.fem_points = sim.contact()->num_fem_points();
   return out;
 }
 
@@ -348,6 +353,13 @@ TEST(MpmMpi, FemFemContactBesideMpmEqualsOneRank) {
   const SceneResult d = run_scene_steps("a6_semiring_buckling.yaml", o, world, 60);
   const SceneResult s = run_scene_steps("a6_semiring_buckling.yaml", o, self, 60);
   compare_scenes(*world, d, s, 1e-8, 1e-6, "A6 rings (FEM-FEM + MPM-FEM)");
+  // Every FEM boundary node is a contact point on exactly one rank, and (the
+  // plate and ring cut by RCB) every rank holds some.
+  int points = 0, fewest = 0;
+  Teuchos::reduceAll(*world, Teuchos::REDUCE_SUM, d.fem_points, Teuchos::outArg(points));
+  Teuchos::reduceAll(*world, Teuchos::REDUCE_MIN, d.fem_points, Teuchos::outArg(fewest));
+  EXPECT_EQ(points, s.fem_points);
+  EXPECT_GT(fewest, 0);
   // The plate presses the outer ring into the inner one: the MPM ring's
   // crown has moved down by then.
   if (world->getRank() != 0) return;
