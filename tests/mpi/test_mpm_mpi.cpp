@@ -221,6 +221,14 @@ SceneResult run_scene_steps(const std::string& file, const std::vector<std::stri
   return out;
 }
 
+// The scene on the default communicator's ranks, then on each rank alone.
+std::pair<SceneResult, SceneResult> on_world_and_alone(const std::string& file, const std::vector<std::string>& o,
+                                                       int steps) {
+  SceneResult d = run_scene_steps(file, o, Tpetra::getDefaultComm(), steps);
+  SceneResult s = run_scene_steps(file, o, Teuchos::rcp(new Teuchos::MpiComm<int>(MPI_COMM_SELF)), steps);
+  return {std::move(d), std::move(s)};
+}
+
 void compare_scenes(const Comm& world, const SceneResult& d, const SceneResult& s, double x_tol, double f_tol,
                     const std::string& what) {
   compare<2>(world, d.r, s.r, x_tol, what);
@@ -244,14 +252,10 @@ void compare_scenes(const Comm& world, const SceneResult& d, const SceneResult& 
 }  // namespace
 
 TEST(MpmMpi, CollidingRingsMpmFemContactEqualsOneRank) {
-  auto world = Tpetra::getDefaultComm();
-  Teuchos::RCP<const Comm> self = Teuchos::rcp(new Teuchos::MpiComm<int>(MPI_COMM_SELF));
-  const std::vector<std::string> o = {"Time/end time=0.04", "Newton/eps_d=1e-9"};
-  const SceneResult d = run_scene_steps("contact_rings.yaml", o, world, 40);
-  const SceneResult s = run_scene_steps("contact_rings.yaml", o, self, 40);
+  const auto [d, s] = on_world_and_alone("contact_rings.yaml", {"Time/end time=0.04", "Newton/eps_d=1e-9"}, 40);
   // Newton stops at |p|/dt < 1e-9 m/s (dt 1e-3): 1e-12 m per step; the
   // barrier's stiffness amplifies it through contact (measured 1e-12 m).
-  compare_scenes(*world, d, s, 1e-9, 1e-6, "rings");
+  compare_scenes(*Tpetra::getDefaultComm(), d, s, 1e-9, 1e-6, "rings");
 }
 
 // With every friction pass at eps_d ('Contact/friction pass tolerance' 1)
@@ -292,22 +296,14 @@ TEST(MpmMpi, DiskOnMpmFloorWithFrictionEqualsOneRank) {
 // mu 0.1, below the critical 0.2, so that the lagged friction loop runs on
 // every step in contact).
 TEST(MpmMpi, DiskWallImpactEqualsOneRank) {
-  auto world = Tpetra::getDefaultComm();
-  Teuchos::RCP<const Comm> self = Teuchos::rcp(new Teuchos::MpiComm<int>(MPI_COMM_SELF));
-  const std::vector<std::string> o = {"Newton/eps_d=1e-9"};
-  const SceneResult d = run_scene_steps("contact_disk_wall.yaml", o, world, 20);
-  const SceneResult s = run_scene_steps("contact_disk_wall.yaml", o, self, 20);
-  compare_scenes(*world, d, s, 1e-9, 1e-6, "disk-wall impact");
+  const auto [d, s] = on_world_and_alone("contact_disk_wall.yaml", {"Newton/eps_d=1e-9"}, 20);
+  compare_scenes(*Tpetra::getDefaultComm(), d, s, 1e-9, 1e-6, "disk-wall impact");
 }
 
 TEST(MpmMpi, BoxSlidingOnTheSlopeWithFrictionEqualsOneRank) {
-  auto world = Tpetra::getDefaultComm();
-  Teuchos::RCP<const Comm> self = Teuchos::rcp(new Teuchos::MpiComm<int>(MPI_COMM_SELF));
-  const std::vector<std::string> o = {"Time/end time=0.04", "Contact/friction=0.1",
-                                      "Contact/friction pass tolerance=1"};
-  const SceneResult d = run_scene_steps("contact_slope.yaml", o, world, 40);
-  const SceneResult s = run_scene_steps("contact_slope.yaml", o, self, 40);
-  compare_scenes(*world, d, s, 1e-9, 1e-6, "box on the slope, mu 0.1");
+  const auto [d, s] = on_world_and_alone(
+      "contact_slope.yaml", {"Time/end time=0.04", "Contact/friction=0.1", "Contact/friction pass tolerance=1"}, 40);
+  compare_scenes(*Tpetra::getDefaultComm(), d, s, 1e-9, 1e-6, "box on the slope, mu 0.1");
 }
 
 // A moving slip level set (VALIDATION A2's sine press, level-set form): the
@@ -319,10 +315,7 @@ TEST(MpmMpi, BoxSlidingOnTheSlopeWithFrictionEqualsOneRank) {
 // box down (its particles' mean height falls; nothing else moves it).
 TEST(MpmMpi, MovingSlipLevelSetEqualsOneRank) {
   auto world = Tpetra::getDefaultComm();
-  Teuchos::RCP<const Comm> self = Teuchos::rcp(new Teuchos::MpiComm<int>(MPI_COMM_SELF));
-  const std::vector<std::string> o = {"Time/end time=0.06", "Newton/eps_d=1e-9"};
-  const SceneResult d = run_scene_steps("a2_sine_press_levelset.yaml", o, world, 30);
-  const SceneResult s = run_scene_steps("a2_sine_press_levelset.yaml", o, self, 30);
+  const auto [d, s] = on_world_and_alone("a2_sine_press_levelset.yaml", {"Time/end time=0.06", "Newton/eps_d=1e-9"}, 30);
   // Newton stops at |p|_inf / dt < 1e-9 m/s (dt 2e-3): 2e-12 m per step.
   compare<2>(*world, d.r, s.r, 1e-9, "sine press, slip level set");
   if (world->getRank() != 0) return;
@@ -346,12 +339,11 @@ TEST(MpmMpi, MovingSlipLevelSetEqualsOneRank) {
 // first steps, the ring-ring pairs once the 0.01 m gap has closed.
 TEST(MpmMpi, FemFemContactBesideMpmEqualsOneRank) {
   auto world = Tpetra::getDefaultComm();
-  Teuchos::RCP<const Comm> self = Teuchos::rcp(new Teuchos::MpiComm<int>(MPI_COMM_SELF));
-  const std::vector<std::string> o = {"Time/end time=0.6", "Newton/eps_d=1e-9",
-                                      "Contact/Friction Pairs/inner : outer=0.2",
-                                      "Contact/friction pass tolerance=1"};
-  const SceneResult d = run_scene_steps("a6_semiring_buckling.yaml", o, world, 60);
-  const SceneResult s = run_scene_steps("a6_semiring_buckling.yaml", o, self, 60);
+  const auto [d, s] = on_world_and_alone("a6_semiring_buckling.yaml",
+                                         {"Time/end time=0.6", "Newton/eps_d=1e-9",
+                                          "Contact/Friction Pairs/inner : outer=0.2",
+                                          "Contact/friction pass tolerance=1"},
+                                         60);
   compare_scenes(*world, d, s, 1e-8, 1e-6, "A6 rings (FEM-FEM + MPM-FEM)");
   // Every FEM boundary node is a contact point on exactly one rank, and (the
   // plate and ring cut by RCB) every rank holds some.
