@@ -123,18 +123,33 @@ TEST(MpmMpi, SharedGridNodesAreOwnedOnTheirSideOfTheCut) {
   compare<2>(*world, d, s, 1e-9, "2D block across the cut");
 }
 
+namespace {
+// A 0.3 m cube thrown at 2 m/s across the cut at x = 0.6, under gravity; with
+// slip_plane, over a slip plane tilted in x and z just below it.
+SimulationSetup<3> thrown_cube(bool slip_plane) {
+  auto s = fixtures::cube_setup(Vec<3>(0.45, 0.5, 0.5), Vec<3>(0.3, 0.3, 0.3), 0.1, Vec<3>(0.0, 0.0, 0.0),
+                                Vec<3>(1.2, 1.0, 1.0), 8);
+  set_velocity<3>(s.mpm->particles, 0, s.mpm->particles.size(), Vec<3>(2.0, 0.0, 0.0));
+  s.gravity = {0.0, -9.81, 0.0};
+  s.dt = 1e-2;
+  tight_cg(s);
+  if (slip_plane) {
+    LevelSet plane;
+    plane.name = "incline";
+    plane.slip = true;
+    plane.point = {0.45, 0.31, 0.5};
+    const double len = std::sqrt(0.15 * 0.15 + 1.0 + 0.1 * 0.1);
+    plane.normal = {0.15 / len, 1.0 / len, 0.1 / len};
+    s.level_sets.push_back(plane);
+  }
+  return s;
+}
+}  // namespace
+
 TEST(MpmMpi, CubeThrownAcrossTheCutEqualsOneRank3D) {
   auto world = Tpetra::getDefaultComm();
   Teuchos::RCP<const Comm> self = Teuchos::rcp(new Teuchos::MpiComm<int>(MPI_COMM_SELF));
-  auto setup = [] {
-    auto s = fixtures::cube_setup(Vec<3>(0.45, 0.5, 0.5), Vec<3>(0.3, 0.3, 0.3), 0.1, Vec<3>(0.0, 0.0, 0.0),
-                                  Vec<3>(1.2, 1.0, 1.0), 8);
-    set_velocity<3>(s.mpm->particles, 0, s.mpm->particles.size(), Vec<3>(2.0, 0.0, 0.0));
-    s.gravity = {0.0, -9.81, 0.0};
-    s.dt = 1e-2;
-    tight_cg(s);
-    return s;
-  };
+  auto setup = [] { return thrown_cube(false); };
   Simulation<3> dist(setup(), world);
   const Result d = run_steps(dist, 8);
   Simulation<3> alone(setup(), self);
@@ -149,22 +164,7 @@ TEST(MpmMpi, CubeThrownAcrossTheCutEqualsOneRank3D) {
 TEST(MpmMpi, CubeOnATiltedSlipPlaneAcrossTheCutEqualsOneRank3D) {
   auto world = Tpetra::getDefaultComm();
   Teuchos::RCP<const Comm> self = Teuchos::rcp(new Teuchos::MpiComm<int>(MPI_COMM_SELF));
-  auto setup = [] {
-    auto s = fixtures::cube_setup(Vec<3>(0.45, 0.5, 0.5), Vec<3>(0.3, 0.3, 0.3), 0.1, Vec<3>(0.0, 0.0, 0.0),
-                                  Vec<3>(1.2, 1.0, 1.0), 8);
-    set_velocity<3>(s.mpm->particles, 0, s.mpm->particles.size(), Vec<3>(2.0, 0.0, 0.0));
-    s.gravity = {0.0, -9.81, 0.0};
-    s.dt = 1e-2;
-    tight_cg(s);
-    LevelSet plane;
-    plane.name = "incline";
-    plane.slip = true;
-    plane.point = {0.45, 0.31, 0.5};
-    const double len = std::sqrt(0.15 * 0.15 + 1.0 + 0.1 * 0.1);
-    plane.normal = {0.15 / len, 1.0 / len, 0.1 / len};
-    s.level_sets.push_back(plane);
-    return s;
-  };
+  auto setup = [] { return thrown_cube(true); };
   Simulation<3> dist(setup(), world);
   const Result d = run_steps(dist, 8);
   int constrained = static_cast<int>(dist.newton().slip_constraints().count()), total = 0;
