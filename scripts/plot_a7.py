@@ -53,7 +53,7 @@ def main():
         print(f"mu {mu}: frames to t = {t[-1]:.2f} s; peak rotation {rot[k] / np.pi:.3f} pi at t = {t[k]:.2f} s "
               f"(z0 > 0.85: {deep[kd] / np.pi:.3f} pi at t = {t[kd]:.2f} s)")
         line, = ax.plot(t, rot / np.pi, label=f"mu = {mu} (peak {rot[k] / np.pi:.2f} pi)")
-        ax.plot(t, deep / np.pi, ":", lw=0.9, color=line.get_color())
+        ax.plot(t, deep / np.pi, ":", lw=0.9, color=line.get_color(), label=f"mu = {mu}, set z0 > 0.85 (before)")
     tc = np.linspace(0, max(tmax, 1.0), 200)
     ax.plot(tc, np.clip(tc - 1.0, 0, 4.5) / 5.0, "k--", lw=0.8, label="shell cap twist")
     ax.set_xlabel("t (s)")
