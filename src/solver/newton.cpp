@@ -286,6 +286,15 @@ NewtonStats NewtonSolver<dim>::minimize(const IncrementalPotential& ip, View1 x,
   auto trial = m.trial;
   double r0_norm = 0;
   bool lifted = false;  // the previous iteration still moved prescribed DOFs
+  // While prescribed DOFs are still on their way the line search does not
+  // guard the energy (below): the step is the bounded (CCD, inversion) one.
+  // Once such a step fell short of them, the next ones take the projected
+  // Hessian until they arrive: its direction minimises a convex model, where
+  // the exact Hessian's (definite as a whole, indefinite in some pairs: the
+  // friction's edge and vertex compensation) can keep driving the free DOFs
+  // into the barrier, each bounded step 0.9 of the way (A6 at the paper's
+  // size: |rhs| 3e3 -> 1e26 in 60 iterations, then a NaN solve).
+  bool lift_blocked = false;
   const bool try_exact =
       m.params.hessian == HessianMode::ExactIfDefinite && m.solver.detects_indefinite();
   if (m.modes_stale || ++m.solves_since_modes >= m.solver.near_null_space_every()) m.refresh_modes(x);
@@ -312,7 +321,8 @@ NewtonStats NewtonSolver<dim>::minimize(const IncrementalPotential& ip, View1 x,
       m.refresh_modes(x);
       ++st.graph_builds;
     }
-    bool project = !try_exact;
+    if (pres_left == 0.0) lift_blocked = false;
+    bool project = !try_exact || lift_blocked;
     m.assemble(ip, x, project);
     if (m.dofs.dropped_blocks() > 0) {
       // A term's couplings were not in the cached graph: never drop them.
@@ -551,6 +561,7 @@ NewtonStats NewtonSolver<dim>::minimize(const IncrementalPotential& ip, View1 x,
     Kokkos::fence();
     st.line_search_s += timer.seconds();
     st.min_step = std::min(st.min_step, alpha);
+    if (pres_left > 0.0 && alpha < 1.0) lift_blocked = true;
     if (m.params.log_iterations && m.comm->getRank() == 0)
       std::fprintf(stderr,
                    "  newton %3d  |p|/dt %.3e m/s  step %.3e%s  (bound %.3e)  |rhs| %.3e  %s Hessian%s  linear %d "
