@@ -26,7 +26,7 @@ namespace {
 
 const char* kRestartKeys[] = {"Time/end time", "Output/", "Newton/", "Linear Solver/", "MPM/boxes per axis",
                               "Contact/friction iterations",
-                              "Contact/friction pass tolerance",
+                              "Contact/friction pass tolerance", "Contact/friction relaxation from",
                               "Contact/check iterates", "Contact/eps_v"};
 
 std::string join_lines(const std::vector<std::string>& v) {

@@ -28,6 +28,9 @@ struct ContactParams {
   // after that stop at eps_d (Simulation::minimize_with_friction). 1: every
   // pass at eps_d.
   double friction_pass_tolerance = 10.0;
+  // From this pass on the friction loop lags at an Aitken-relaxed point
+  // (Simulation::minimize_with_friction); 0: never (plain lagging).
+  int friction_relaxation_from = 7;
   std::vector<double> mu;  // [mpm body * n_fem + fem body]; empty: frictionless
   int force_body = -1;     // FEM body whose contact force is reported (-1: all)
   bool check_iterates = false;  // debug: every Newton iterate is checked for penetration
@@ -85,6 +88,7 @@ class Contact {
   LO update_friction(ConstDofView x, ConstDofView x_ref, double s, double dt);
   int friction_max_iterations() const { return params_.friction_max_iterations; }
   double friction_pass_tolerance() const { return params_.friction_pass_tolerance; }
+  int friction_relaxation_from() const { return params_.friction_relaxation_from; }
 
   struct Report {
     LO pairs = 0;                   // pairs with d < dhat

@@ -91,6 +91,7 @@ ContactParams contact_from(const ParameterList& p) {
   cp.graph_margin = c.get<double>("graph margin");
   cp.friction_max_iterations = c.get<int>("friction iterations");
   cp.friction_pass_tolerance = c.get<double>("friction pass tolerance");
+  cp.friction_relaxation_from = c.get<int>("friction relaxation from");
   const std::size_t nm = mpm.numParams(), nf = fem.numParams();
   cp.fem_fem = c.get<bool>("FEM-FEM");
   cp.mpm_bodies = static_cast<int>(nm);

@@ -128,6 +128,7 @@ void check_contact(const ParameterList& raw) {
   if (!(c.get<double>("graph margin") >= 0))
     bad("Contact/graph margin", num(c.get<double>("graph margin")), "a margin >= 0 (in multiples of dhat)");
   at_least(c, "Contact/", "friction iterations", 1);
+  at_least(c, "Contact/", "friction relaxation from", 0);
   if (!(std::isfinite(c.get<double>("friction pass tolerance")) && c.get<double>("friction pass tolerance") >= 1.0))
     bad("Contact/friction pass tolerance", num(c.get<double>("friction pass tolerance")),
         "a finite multiple of Newton/eps_d >= 1 (1: every friction pass at eps_d)");

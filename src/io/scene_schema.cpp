@@ -259,6 +259,12 @@ Teuchos::RCP<const ParameterList> scene_schema() {
               "within it at its first iteration; later passes stop at eps_d, and the loop ends, as in the paper's "
               "Algorithm 1, at a pass whose first Newton direction is below eps_d (the same test; fewer Newton "
               "iterations: the ci twist to 1.2 s, 2302 -> 1765); >= 1 (1: every pass at eps_d)");
+  contact.set("friction relaxation from", 7,
+              "the first friction pass lagged at x_lag + omega (x - x_lag) with Aitken's omega in [0.05, 1] "
+              "instead of at the last pass's x (the same fixed point; a loop that has not converged by then is "
+              "usually oscillating: A6's plate pressing the ring at mu 10); the loop then ends only when x_lag "
+              "is within eps_d dt of x too; >= 0 (0: never, the paper's plain lagging; 1 and 2 act as 3: Aitken "
+              "needs two passes' residuals)");
   contact.set("force body", std::string(""), "FEM body whose contact force goes to diagnostics.csv (default: all)");
   contact.set("FEM-FEM", false,
               "true: the FEM bodies also contact each other (2D; boundary nodes against the other bodies' edges), "

@@ -93,6 +93,7 @@ const std::vector<Leaf> kLeaves = {
     {"Contact/Friction Pairs/disk : wall", "0.2", Kind::Real},
     {"Contact/friction iterations", "5", Kind::Int},
     {"Contact/friction pass tolerance", "3.0", Kind::Real},
+    {"Contact/friction relaxation from", "3", Kind::Int},
     {"Contact/force body", "wall", Kind::Text},
     {"Contact/check iterates", "false", Kind::Bool},
 };
@@ -161,6 +162,7 @@ const std::map<std::string, std::set<Mut>> kMayRun = {
     {"Contact/Friction Pairs/disk : wall", {Mut::Zero, Mut::Missing}},
     {"Contact/friction iterations", {Mut::Missing}},
     {"Contact/friction pass tolerance", {Mut::Missing}},  // 10
+    {"Contact/friction relaxation from", {Mut::Zero, Mut::Missing}},  // 0: never relaxed
     {"Contact/force body", {Mut::Empty, Mut::Missing}},
     {"Contact/check iterates", {Mut::Missing}},
 };
