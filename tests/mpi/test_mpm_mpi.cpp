@@ -306,6 +306,19 @@ TEST(MpmMpi, BoxSlidingOnTheSlopeWithFrictionEqualsOneRank) {
   compare_scenes(*Tpetra::getDefaultComm(), d, s, 1e-9, 1e-6, "box on the slope, mu 0.1");
 }
 
+// The same with the friction loop lagged at Aitken-relaxed points from its
+// third pass (Contact/friction relaxation from = 3; 3 of the 40 steps' loops
+// reach a third pass): omega comes from dot products over the owned DOFs
+// summed over the ranks, so every rank lags at the same point and the run
+// equals one rank.
+TEST(MpmMpi, BoxSlidingOnTheSlopeWithRelaxedFrictionPassesEqualsOneRank) {
+  const auto [d, s] = on_world_and_alone("contact_slope.yaml",
+                                         {"Time/end time=0.04", "Contact/friction=0.1",
+                                          "Contact/friction pass tolerance=1", "Contact/friction relaxation from=3"},
+                                         40);
+  compare_scenes(*Tpetra::getDefaultComm(), d, s, 1e-9, 1e-6, "box on the slope, mu 0.1, relaxed passes");
+}
+
 // A moving slip level set (VALIDATION A2's sine press, level-set form): the
 // sine boundary presses the box down for 0.04 s, then drags left, as an exact
 // constraint on the grid nodes inside it (n . v = the boundary's, tangent
